@@ -1,0 +1,65 @@
+"""Strict parsing of quantities with units.
+
+fretsim works internally in the consistent mm–N–MPa system: lengths in mm,
+forces in N, pressures and moduli in MPa (N/mm²), wear coefficients in 1/MPa
+(mm²/N, so that k·p·s is a length in mm).  Every dimensional value in a case
+file carries its unit; this module converts it to the internal unit or says
+exactly why it cannot.  It is deliberately tiny (a table, one regex) so that
+the CLI starts quickly in sweeps that launch it thousands of times.
+"""
+from __future__ import annotations
+
+import math
+import re
+
+# dimension -> {unit spelling: factor to the internal unit}
+UNITS: dict[str, dict[str, float]] = {
+    "length": {"m": 1e3, "mm": 1.0, "um": 1e-3, "µm": 1e-3, "micron": 1e-3, "nm": 1e-6, "cm": 10.0},
+    "force": {"N": 1.0, "kN": 1e3, "mN": 1e-3},
+    "pressure": {"Pa": 1e-6, "kPa": 1e-3, "MPa": 1.0, "GPa": 1e3, "N/mm2": 1.0, "N/mm^2": 1.0},
+    "wear_coefficient": {"1/MPa": 1.0, "1/Pa": 1e6, "1/GPa": 1e-3, "mm2/N": 1.0, "mm^2/N": 1.0, "m2/N": 1e6,
+                         "m^2/N": 1e6},
+}
+INTERNAL = {"length": "mm", "force": "N", "pressure": "MPa", "wear_coefficient": "1/MPa"}
+
+_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf|nan)\s*(\S+)\s*$", re.IGNORECASE)
+
+
+class UnitError(ValueError):
+    """A value whose unit is missing, unknown or of the wrong dimension."""
+
+
+def parse_quantity(value: object, dimension: str) -> float:
+    """Return ``value`` (e.g. ``"25 um"``) in the internal unit of ``dimension``.
+
+    Raises :class:`UnitError` with a message that says what was expected.
+    """
+    table = UNITS[dimension]
+    expected = f"a number with a {dimension.replace('_', ' ')} unit ({', '.join(list(table)[:5])}), e.g. '{_example(dimension)}'"
+    if isinstance(value, bool) or value is None:
+        raise UnitError(f"got {value!r}; expected {expected}")
+    if isinstance(value, (int, float)):
+        raise UnitError(f"got the bare number {value!r} without a unit; expected {expected}")
+    if not isinstance(value, str):
+        raise UnitError(f"got a {type(value).__name__}; expected {expected}")
+    m = _QUANTITY.match(value)
+    if not m:
+        raise UnitError(f"could not read {value!r}; expected {expected}")
+    number, unit = float(m.group(1)), m.group(2)
+    if unit not in table:
+        for dim, other in UNITS.items():
+            if unit in other and dim != dimension:
+                raise UnitError(f"{value!r} is a {dim.replace('_', ' ')}, not a {dimension.replace('_', ' ')}; expected {expected}")
+        raise UnitError(f"unknown unit {unit!r} in {value!r}; expected {expected}")
+    if not math.isfinite(number):
+        raise UnitError(f"{value!r} is not a finite number")
+    return number * table[unit]
+
+
+def _example(dimension: str) -> str:
+    return {"length": "25 um", "force": "185 N", "pressure": "200 GPa", "wear_coefficient": "2.0e-8 1/MPa"}[dimension]
+
+
+def format_quantity(value: float, dimension: str) -> str:
+    """Inverse of :func:`parse_quantity` in the internal unit (used to write the filled case)."""
+    return f"{value:.12g} {INTERNAL[dimension]}"
