@@ -110,8 +110,9 @@ class Compliance:
         if n > DENSE_LIMIT:
             raise ValueError(f"a dense compliance matrix for {n} elements would take {n * n * 8 / 1e9:.1f} GB; "
                              f"use an FFT-based solver (limit {DENSE_LIMIT} elements)")
-        jy, ix = np.divmod(np.arange(n), nx)
-        return self.kernel[(jy[:, None] - jy[None, :]) + ny - 1, (ix[:, None] - ix[None, :]) + nx - 1]
+        # C[(jy,ix),(ky,kx)] = K[jy-ky+ny-1, ix-kx+nx-1]: windows of the flipped kernel, one strided copy
+        windows = np.lib.stride_tricks.sliding_window_view(self.kernel[::-1, ::-1], (ny, nx))
+        return np.ascontiguousarray(windows[::-1, ::-1]).reshape(n, n)
 
     def symbol(self) -> np.ndarray:
         """Real Fourier symbol of C on the padded grid (rfft2 layout): its eigenvalues for periodic modes."""

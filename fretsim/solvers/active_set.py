@@ -5,8 +5,8 @@ On a contact set S the separations vanish and the load balances:
     [C_SS  −e] [p_S]   [−ε_S]
     [eᵀ     0] [ α ] = [ W/A ]
 
-Elements with negative pressure leave S, penetrating ones join, until
-neither happens.  Exact to round-off in a handful of dense solves, so it is
+Elements with negative pressure leave S, penetrating ones join (at most
+doubling S per sweep), until neither happens.  Exact to round-off in a handful of dense solves, so it is
 the independent check on the iterative solvers for small grids.
 """
 from __future__ import annotations
@@ -71,7 +71,10 @@ def solve_active_set(compliance: Compliance, gap: np.ndarray, load: float, p0: O
             success = True
             message = f"active_set converged in {it} sweeps ({k} elements in contact)"
             break
-        active |= penetrating
+        # grow by at most the current size, most penetrating first: adding every penetrating element
+        # after a poor guess overshoots to a huge dense system
+        cand = np.flatnonzero(penetrating)
+        active[cand[np.argsort(y[cand])[:max(k, 1)]]] = True
     else:
         message = f"active_set: contact set still changing after {max_iter} sweeps"
     full = np.zeros(gap.size)

@@ -1,0 +1,133 @@
+"""`fretsim` command line: run, summary, plot.  No algorithm here: it wraps :mod:`fretsim.api`.
+
+Exit codes: 0 complete, 2 bad input (case, options, files), 3 a run that failed numerically or outgrew its grid,
+130 interrupted.
+"""
+from __future__ import annotations
+
+import json
+import sys
+import traceback
+from pathlib import Path
+
+import click
+
+EXIT_BAD_INPUT = 2
+EXIT_FAILED = 3
+EXIT_INTERRUPTED = 130
+
+
+def _fail(message: str, code: int, debug: bool) -> None:
+    if debug:
+        traceback.print_exc()
+    click.echo(f"fretsim: {message}", err=True)
+    sys.exit(code)
+
+
+@click.group(context_settings={"help_option_names": ["-h", "--help"]})
+@click.version_option(package_name="fretsim")
+def main() -> None:
+    """Fretting-wear simulation after Kong, Bennett & Hyde: YAML case → HDF5 results → PNG plots."""
+
+
+@main.command()
+@click.argument("case_file", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+              help="Results file (default: CASE_FILE's name with .h5, in the current directory).")
+@click.option("--set", "overrides", multiple=True, metavar="KEY.PATH=VALUE",
+              help="Override a case value, e.g. --set loading.cycles=1000 (repeatable).")
+@click.option("--overwrite", is_flag=True, help="Replace an existing results file.")
+@click.option("--debug", is_flag=True, help="Show tracebacks.")
+def run(case_file: Path, output: Path | None, overrides: tuple, overwrite: bool, debug: bool) -> None:
+    """Run CASE_FILE and write an HDF5 results file."""
+    from fretsim.api import CaseError, load_case, run as run_case
+
+    output = output or Path(case_file.stem + ".h5")
+    try:
+        case = load_case(case_file, list(overrides))
+        bar = None
+        if sys.stderr.isatty() and case.cycles > 0:
+            bar = click.progressbar(length=case.cycles, label=f"{case.name}", file=sys.stderr, show_eta=True)
+            bar.__enter__()
+        try:
+            outcome = run_case(case, output, overwrite=overwrite, progress=bar.update if bar else None)
+        finally:
+            if bar is not None:
+                bar.__exit__(None, None, None)
+    except CaseError as exc:
+        _fail(str(exc), EXIT_BAD_INPUT, debug)
+    except KeyboardInterrupt:
+        _fail(f"interrupted; every accepted step so far is in {output} (status 'interrupted')", EXIT_INTERRUPTED,
+              debug)
+    except OSError as exc:
+        _fail(f"cannot write {output}: {exc}", EXIT_BAD_INPUT, debug)
+    for note in outcome.notes:
+        click.echo(f"note: {note}", err=True)
+    if outcome.status != "complete":
+        _fail(f"run failed: {outcome.message}" + (f"; steps up to the failure are in {output} (status 'failed')"
+                                                  if outcome.last is not None else ""), EXIT_FAILED, debug)
+    click.echo(_paragraph(outcome))
+
+
+def _paragraph(outcome) -> str:
+    s, c, g = outcome.summary, outcome.case, outcome.setup.grid
+    cells = f"{g.shape[1]} elements" if g.plane_strain else f"{g.shape[1]} × {g.shape[0]} elements"
+    size = f"{g.dx * 1e3:.3g} µm" if g.plane_strain else f"{g.dx * 1e3:.3g} × {g.dy * 1e3:.3g} µm"
+    text = (f"{c.name}: {s['cycles']} cycles, {c.dimension.upper()} {c.geometry}, {cells} of {size}, solver "
+            f"{c.solver}, linear jump {s['linear_jump']} cycles (stability limit {s['stability_limit_linear']:.3g}); "
+            f"{s['contact_solves']} contact solves in {s['wall_time_s']:.2f} s.")
+    if s["cycles"] > 0:
+        text += (f" Stationary body: centre-line wear depth {s['centre_wear_depth_stationary_um']:.3g} µm "
+                 f"(max {s['max_wear_depth_stationary_um']:.3g} µm), scar width {s['scar_width_stationary_mm']:.3g} mm,"
+                 f" volume {s['wear_volume_stationary_mm3']:.4g} mm³. Moving body: centre-line "
+                 f"{s['centre_wear_depth_moving_um']:.3g} µm (max {s['max_wear_depth_moving_um']:.3g} µm), volume "
+                 f"{s['wear_volume_moving_mm3']:.4g} mm³. Archard volume error {s['archard_volume_error']:.1e}.")
+    else:
+        text += f" Contact only: peak pressure {s['max_pressure_MPa']:.4g} MPa."
+    return text + f" Results: {outcome.output}"
+
+
+@main.command()
+@click.argument("results_file", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("--json", "as_json", is_flag=True, help="Machine-readable output for sweeps.")
+@click.option("--debug", is_flag=True, help="Show tracebacks.")
+def summary(results_file: Path, as_json: bool, debug: bool) -> None:
+    """Print the summary figures of RESULTS_FILE (the /summary attributes)."""
+    from fretsim.results import read_results
+
+    try:
+        res = read_results(results_file)
+    except ValueError as exc:
+        _fail(str(exc), EXIT_BAD_INPUT, debug)
+    data = {"status": res.status, "case_name": res.attrs.get("case_name"), **res.summary}
+    if as_json:
+        click.echo(json.dumps(data, indent=2, sort_keys=False))
+    else:
+        width = max(len(k) for k in data)
+        for k, v in data.items():
+            click.echo(f"{k:<{width}}  {v:.6g}" if isinstance(v, float) else f"{k:<{width}}  {v}")
+
+
+@main.command()
+@click.argument("results_file", type=click.Path(dir_okay=False, path_type=Path))
+@click.option("-o", "--outdir", type=click.Path(file_okay=False, path_type=Path),
+              help="Directory for the PNGs (default: next to RESULTS_FILE).")
+@click.option("--debug", is_flag=True, help="Show tracebacks.")
+def plot(results_file: Path, outdir: Path | None, debug: bool) -> None:
+    """Write PNG figures of RESULTS_FILE: wear profiles, wear maps, max wear vs cycles, pressure profiles."""
+    from fretsim.plotting import plot_all
+    from fretsim.results import read_results
+
+    try:
+        res = read_results(results_file)
+        paths = plot_all(res, outdir or results_file.parent)
+    except ValueError as exc:
+        _fail(str(exc), EXIT_BAD_INPUT, debug)
+    except OSError as exc:
+        _fail(f"cannot write plots: {exc}", EXIT_BAD_INPUT, debug)
+    for p in paths:
+        click.echo(str(p))
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,104 @@
+"""The case file: contract layout, units, and clear errors that name the YAML path."""
+import pytest
+
+from fretsim.case import CaseError, load_case, parse_case
+
+CONTRACT = """
+name: mccoll-185N
+geometry:  {type: cylinder_on_flat, radius: 6 mm, length: 10 mm}
+materials:
+  moving:     {youngs_modulus: 200 GPa, poissons_ratio: 0.3, wear_coefficient: 2.0e-8 1/MPa}
+  stationary: {youngs_modulus: 200 GPa, poissons_ratio: 0.3, wear_coefficient: 3.0e-8 1/MPa}
+loading:   {normal_load: 185 N, stroke: 25 um, cycles: 18000}   # stroke = amplitude δ
+model:     {dimension: 3d}
+solver:    {method: cg}
+jumping:   {linear: 55}
+grid:      {}
+output:    {snapshots: [1000, 5000, 10000, 18000]}
+"""
+
+
+def problems_of(text, overrides=None):
+    with pytest.raises(CaseError) as info:
+        parse_case(text, overrides=overrides)
+    return dict(info.value.problems), str(info.value)
+
+
+def test_the_issue_example_case_parses_into_internal_units():
+    c = parse_case(CONTRACT)
+    assert (c.radius, c.length, c.normal_load, c.stroke, c.cycles) == (6.0, 10.0, 185.0, 0.025, 18000)
+    assert c.moving.youngs_modulus == 2.0e5 and c.stationary.wear_coefficient == 3.0e-8
+    assert (c.dimension, c.solver, c.linear_jump, c.snapshots) == ("3d", "cg", 55, (1000, 5000, 10000, 18000))
+
+
+def test_filled_case_round_trips():
+    c = parse_case(CONTRACT)
+    again = parse_case(c.to_yaml())
+    assert again == c
+
+
+def test_missing_key_is_named():
+    probs, _ = problems_of(CONTRACT.replace("radius: 6 mm, ", ""))
+    assert "geometry.radius" in probs and "missing" in probs["geometry.radius"]
+
+
+def test_unknown_key_gets_did_you_mean():
+    probs, _ = problems_of(CONTRACT.replace("stroke:", "strok:"))
+    assert "did you mean 'stroke'" in probs["loading.strok"]
+
+
+def test_wrong_unit_dimension_is_caught():
+    probs, _ = problems_of(CONTRACT.replace("normal_load: 185 N", "normal_load: 185 mm"))
+    assert "is a length, not a force" in probs["loading.normal_load"]
+
+
+def test_bare_number_for_a_length_is_an_error():
+    probs, _ = problems_of(CONTRACT.replace("stroke: 25 um", "stroke: 25"))
+    assert "without a unit" in probs["loading.stroke"]
+
+
+def test_negative_load_is_rejected():
+    probs, _ = problems_of(CONTRACT.replace("185 N", "-185 N"))
+    assert "positive" in probs["loading.normal_load"]
+
+
+def test_stroke_larger_than_the_domain_is_rejected():
+    probs, _ = problems_of(CONTRACT.replace("grid:      {}", "grid: {domain: [0.5 mm, 10 mm], elements: [81, 27]}")
+                           .replace("25 um", "25 mm"))
+    assert "larger than half the grid" in probs["loading.stroke"]
+
+
+def test_all_problems_are_reported_together():
+    probs, text = problems_of(CONTRACT, overrides=["loading.cycles=-1", "model.dimension=4d",
+                                                   "solver.method=msn", "materials.moving.poissons_ratio=0.7"])
+    assert {"loading.cycles", "model.dimension", "solver.method", "materials.moving.poissons_ratio"} <= set(probs)
+    assert "did you mean 'msm'" in probs["solver.method"]
+    assert text.count("\n  - ") == len(probs)
+
+
+def test_yaml_syntax_error_reports_line_and_column():
+    _, text = problems_of("name: x\ngeometry: {type: ball_on_flat, radius: [6 mm\n")
+    assert "line 3" in text or "line 2" in text
+    assert "column" in text
+
+
+@pytest.mark.parametrize("text, expect", [("", "empty"), ("- a\n- b\n", "mapping"),
+                                          ("geometry: [1, 2]\n", "geometry")])
+def test_structurally_wrong_files_are_explained(text, expect):
+    _, msg = problems_of(text)
+    assert expect in msg
+
+
+def test_ball_in_2d_is_refused():
+    text = CONTRACT.replace("type: cylinder_on_flat, radius: 6 mm, length: 10 mm", "type: ball_on_flat, radius: 6 mm")
+    probs, _ = problems_of(text.replace("3d", "2d"))
+    assert "model.dimension" in probs
+
+
+def test_numbers_written_without_a_dot_are_accepted():
+    assert parse_case(CONTRACT, overrides=["solver.tolerance=1e-6"]).tolerance == 1e-6
+
+
+def test_missing_file_is_a_case_error(tmp_path):
+    with pytest.raises(CaseError, match="does not exist"):
+        load_case(tmp_path / "nope.yaml")

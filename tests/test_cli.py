@@ -1,0 +1,80 @@
+"""The command line: run / summary / plot, exit codes, and bad input that leaves files alone."""
+import json
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from fretsim.cli import main
+
+CASES = Path(__file__).resolve().parent.parent / "cases"
+SHORT = ["--set", "loading.cycles=600", "--set", "output.snapshots=[0, 300, 600]"]
+
+
+@pytest.fixture
+def cli(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    return CliRunner()
+
+
+def test_run_summary_plot_round_trip_3d(cli, tmp_path):
+    r = cli.invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), *SHORT])
+    assert r.exit_code == 0, r.output
+    assert "Results: mccoll_185N.h5" in r.output and (tmp_path / "mccoll_185N.h5").exists()
+    r = cli.invoke(main, ["summary", "mccoll_185N.h5", "--json"])
+    data = json.loads(r.output)
+    assert data["status"] == "complete" and data["cycles"] == 600 and data["archard_volume_error"] < 1e-9
+    r = cli.invoke(main, ["plot", "mccoll_185N.h5", "-o", "plots"])
+    assert r.exit_code == 0, r.output
+    pngs = sorted(p.name for p in (tmp_path / "plots").glob("*.png"))
+    assert len(pngs) == 4 and all((tmp_path / "plots" / p).stat().st_size > 10_000 for p in pngs)
+
+
+def _write(tmp_path, text):
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    return path
+
+
+@pytest.mark.parametrize("edit, key", [
+    (("radius: 6 mm, ", ""), "geometry.radius"),  # a missing key
+    (("stroke:", "strok:"), "loading.strok"),  # an unknown key
+    (("185 N", "185 kg"), "loading.normal_load"),  # a wrong unit
+    (("185 N", "-185 N"), "loading.normal_load"),  # a negative load
+    (("grid:      {}", "grid: {domain: [0.4 mm, 10 mm], elements: [61, 27]}"), "loading.stroke"),  # stroke > domain
+])
+def test_bad_case_exits_2_names_the_key_and_writes_nothing(cli, tmp_path, edit, key):
+    text = (CASES / "mccoll_185N.yaml").read_text()
+    if key == "loading.stroke":
+        text = text.replace("stroke: 25 um", "stroke: 250 um")
+    bad = _write(tmp_path, text.replace(*edit))
+    r = cli.invoke(main, ["run", str(bad), "-o", "out.h5"])
+    assert r.exit_code == 2
+    assert key in r.output and "Traceback" not in r.output
+    assert not (tmp_path / "out.h5").exists()
+
+
+def test_existing_results_are_not_overwritten(cli, tmp_path):
+    (tmp_path / "out.h5").write_bytes(b"precious")
+    r = cli.invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), "-o", "out.h5", *SHORT])
+    assert r.exit_code == 2 and "--overwrite" in r.output
+    assert (tmp_path / "out.h5").read_bytes() == b"precious"
+
+
+def test_failed_run_exits_3_and_marks_the_file(cli, tmp_path):
+    r = cli.invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), "-o", "f.h5", "--set", "model.dimension=2d",
+                          "--set", "jumping.linear=80"])
+    assert r.exit_code == 3 and "checkerboard" in r.output
+    assert json.loads(cli.invoke(main, ["summary", "f.h5", "--json"]).output)["status"] == "failed"
+
+
+def test_debug_shows_the_traceback(cli, tmp_path):
+    bad = _write(tmp_path, "name: x\n")
+    assert "Traceback" not in cli.invoke(main, ["run", str(bad)]).output
+    assert "Traceback" in cli.invoke(main, ["run", str(bad), "--debug"]).output
+
+
+def test_summary_of_a_non_results_file_is_a_clear_error(cli, tmp_path):
+    (tmp_path / "junk.h5").write_text("not hdf5")
+    r = cli.invoke(main, ["summary", "junk.h5"])
+    assert r.exit_code == 2 and "not a readable HDF5" in r.output
