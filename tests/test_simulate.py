@@ -143,3 +143,23 @@ def test_runs_are_deterministic(tmp_path):
     a, b = read_results(tmp_path / "1.h5"), read_results(tmp_path / "2.h5")
     for name in FIELDS:
         assert np.array_equal(a.fields[name], b.fields[name])
+
+
+def test_wear_loop_with_the_papers_msm_matches_cg():
+    # two independent solvers in the full loop: every step's pressure agrees to solver tolerance, so must the wear
+    a = results_of("mccoll_185N", "2d", "loading.cycles=2000", "solver.method=msm")
+    b = results_of("mccoll_185N", "2d", "loading.cycles=2000", "solver.method=cg", "solver.tolerance=1e-12")
+    for name in ("wear_depth_stationary", "wear_depth_moving", "pressure"):
+        assert np.abs(a.fields[name] - b.fields[name]).max() <= 1e-6 * np.abs(b.fields[name]).max()
+
+
+@pytest.mark.slow
+def test_3d_halving_the_jump_and_the_element_size_changes_the_depth_by_under_1pct():
+    base = summary_of("mccoll_185N", "3d")
+    nx, ny = base["elements_x"], base["elements_y"]
+    domain = nx * base["element_size_x_um"] * 1e-3
+    fine = summary_of("mccoll_185N", "3d", f"jumping.linear={base['linear_jump'] // 2}",
+                      f"grid.domain=[{domain!r} mm, 10 mm]", f"grid.elements=[{2 * nx}, {ny}]")
+    assert fine["centre_wear_depth_stationary_um"] == pytest.approx(base["centre_wear_depth_stationary_um"],
+                                                                    rel=CONVERGED)
+    assert fine["scar_width_stationary_mm"] == pytest.approx(base["scar_width_stationary_mm"], rel=WIDTH_TOL)
