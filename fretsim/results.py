@@ -40,6 +40,8 @@ HISTORY = {
     "approach": ("um", lambda s: s.approach * 1e3),
     "archard_volume_error": ("1", lambda s: s.archard_error),
     "checkerboard_amplitude": ("1", lambda s: s.checkerboard),
+    "cycle_jump": ("cycles", lambda s: s.jump),
+    "rejected_steps": ("1", lambda s: s.rejected),
 }
 FIELDS = {
     "wear_depth_moving": ("um", lambda s: s.wear_moving * 1e3),
@@ -75,7 +77,7 @@ class ResultsWriter:
         h = f.create_group("history")
         for name, (units, _) in HISTORY.items():
             ds = h.create_dataset(name, shape=(0,), maxshape=(None,), chunks=(1024,),
-                                  dtype="i8" if name in ("cycle", "solver_iterations") else "f8")
+                                  dtype="i8" if name in ("cycle", "solver_iterations", "cycle_jump", "rejected_steps") else "f8")
             ds.attrs["units"] = units
         fl = f.create_group("fields")
         ny, nx = grid.shape

@@ -18,8 +18,10 @@ from fretsim.case import Case, CaseError
 from fretsim.compliance import Compliance
 from fretsim.geometry import initial_separation
 from fretsim.grid import Grid
-from fretsim.jumping import (checkerboard_amplitude, default_linear_jump, explicit_stability_limit, is_checkerboard,
-                             linear_schedule)
+from fretsim.jumping import (Q_LINEAR, ImplicitCompliance, checkerboard_amplitude, default_linear_jump,
+                             explicit_stability_limit, implicit_jump_cap, is_checkerboard, next_implicit_jump,
+                             taylor_extrapolate, taylor_jump)
+from fretsim.refine import coarsen, refine_pressure
 from fretsim.reference import effective_modulus
 from fretsim.sizing import auto_grid
 from fretsim.solvers import check_resolution, solve
@@ -66,6 +68,15 @@ class Setup:
     snapshots: tuple[int, ...]
     volume_factor: float  # grid volume → mm³ (the cylinder length in 2D)
     y_edges_free: bool = False  # True for a cylinder: its ends are where the contact may stop
+    scheme: str = "linear"  # linear | adaptive | implicit
+    eta: float = 0.55
+    max_jump: Optional[int] = None
+    step_tolerance: float = 2e-3
+    implicit_cap: float = float("inf")  # largest ΔN keeping the implicit compliance positive definite
+    coarse: Optional[Grid] = None  # refinement: contact solved here, pressure refined to ``grid``
+    coarse_compliance: Optional[Compliance] = None
+    coarse_gap: Optional[np.ndarray] = None
+    stop_on_checkerboard: bool = True
     notes: tuple[str, ...] = ()
 
 
@@ -80,6 +91,8 @@ class Step:
     wall_time: float  # s since the start of the run
     approach: float
     is_snapshot: bool
+    jump: int = 0  # cycles since the previous step
+    rejected: int = 0  # steps rejected by the error control since the previous accepted one
     volume_moving: float = 0.0  # mm³
     volume_stationary: float = 0.0
     archard_error: float = 0.0
@@ -118,6 +131,8 @@ def prepare(case: Case) -> tuple[Setup, Case]:
     dy = 1.0 if plane else domain[1] / ny
     grid = Grid.centred(nx, ny, domain[0] / nx, dy, plane_strain=plane)
     problems = []
+    if case.scheme == "adaptive" and case.max_jump is None:
+        case = case.with_choices(max_jump=600)  # the paper's ΔN_max
     if case.stroke >= domain[0] / 2:
         problems.append(("loading.stroke", f"the stroke amplitude {case.stroke:.4g} mm is larger than half the "
                                            f"grid's x extent ({domain[0]:.4g} mm): check its unit"))
@@ -132,9 +147,23 @@ def prepare(case: Case) -> tuple[Setup, Case]:
         raise CaseError(case.source, problems)
     gap = initial_separation(case.geometry, grid, case.radius, case.length)
     load = case.normal_load / case.length if plane else case.normal_load
-    limit = explicit_stability_limit(grid, e_star, case.stroke, k_m, k_s)
+    coarse = coarse_gap = coarse_op = None
+    if case.coarse_element is not None:
+        cnx = max(3, int(round(domain[0] / case.coarse_element[0])))
+        cny = 1 if plane else max(1, int(round(domain[1] / case.coarse_element[1])))
+        coarse = Grid.centred(cnx, cny, domain[0] / cnx, 1.0 if plane else domain[1] / cny, plane_strain=plane)
+        coarse_gap = initial_separation(case.geometry, coarse, case.radius, case.length)
+        coarse_op = Compliance(coarse, e_star)
+        notes.append(f"refinement: contact solved on {cnx} x {cny} elements of {coarse.dx * 1e3:.3g} x "
+                     f"{coarse.dy * 1e3:.3g} µm, pressure refined to the {nx} x {ny} grid (Akima weights)")
+    solve_grid = coarse if coarse is not None else grid
+    limit = explicit_stability_limit(solve_grid, e_star, case.stroke, k_m, k_s)
+    cap = implicit_jump_cap(solve_grid, e_star, case.stroke, k_m, k_s)
     jump = case.linear_jump if case.linear_jump is not None else default_linear_jump(limit, case.cycles)
-    if case.linear_jump is None:
+    if case.scheme == "implicit":
+        notes.append(f"implicit (backward-Euler) wear steps under error control, tolerance {case.step_tolerance:g}"
+                     + (f", steps at most {cap:.4g} cycles (positive-definite limit)" if np.isfinite(cap) else ""))
+    elif case.linear_jump is None:
         notes.append(f"linear jump {jump} cycles = half the explicit stability limit {limit:.4g}")
     elif jump > limit:
         notes.append(f"WARNING: jumping.linear = {jump} exceeds the explicit stability limit {limit:.4g} cycles "
@@ -150,7 +179,9 @@ def prepare(case: Case) -> tuple[Setup, Case]:
                   k_moving=k_m, k_stationary=k_s, stroke=case.stroke, cycles=case.cycles, linear_jump=jump,
                   stability_limit=limit, method=case.solver, tolerance=case.tolerance, snapshots=snapshots,
                   volume_factor=case.length if plane else 1.0,
-                  y_edges_free=case.geometry == "cylinder_on_flat", notes=tuple(notes))
+                  y_edges_free=case.geometry == "cylinder_on_flat", scheme=case.scheme, eta=case.eta,
+                  max_jump=case.max_jump, step_tolerance=case.step_tolerance, implicit_cap=cap, coarse=coarse,
+                  coarse_compliance=coarse_op, coarse_gap=coarse_gap, notes=tuple(notes))
     filled = case.with_choices(domain=tuple(domain[:1] if plane else domain), elements=(nx,) if plane else (nx, ny),
                                linear_jump=jump, snapshots=snapshots)
     return setup, filled
@@ -158,61 +189,174 @@ def prepare(case: Case) -> tuple[Setup, Case]:
 
 def simulate(setup: Setup, observers: tuple = (), progress: Optional[Callable[[int], None]] = None) -> Step:
     """Run the loop to ``setup.cycles``; returns the last step.  Raises :class:`SimulationError` on failure."""
-    t0 = time.perf_counter()
-    grid = setup.grid
-    reach = (stroke_weights(grid.dx, setup.stroke).size - 1) // 2
-    h_m = np.zeros(grid.shape)
-    h_s = np.zeros(grid.shape)
+    loop = _Loop(setup, observers, progress)
+    return loop.run()
 
-    def contact(cycle: int, guess: Optional[np.ndarray]):
-        res = solve(setup.compliance, setup.gap + h_m + h_s, setup.load, method=setup.method, p0=guess,
-                    tol=setup.tolerance)
+
+class _Loop:
+    """The loop's only mutable state: the wear of both bodies, the current pressure, the cycle."""
+
+    def __init__(self, setup: Setup, observers, progress):
+        self.s = setup
+        self.observers = observers
+        self.progress = progress
+        self.t0 = time.perf_counter()
+        self.reach = (stroke_weights(setup.grid.dx, setup.stroke).size - 1) // 2
+        self.h_m = np.zeros(setup.grid.shape)
+        self.h_s = np.zeros(setup.grid.shape)
+        self.n = 0
+        self.stops = sorted(set(setup.snapshots) | {setup.cycles})
+
+    # -- the contact solve, on the fine grid or on the coarse one with refinement (Eqs. 11-12) --
+    def contact(self, cycle: int, guess, implicit_cycles: float = 0.0):
+        s = self.s
+        h = self.h_m + self.h_s
+        if s.coarse is not None:
+            op, gap = s.coarse_compliance, s.coarse_gap + coarsen(h, s.grid, s.coarse)
+            guess = None if guess is None else coarsen(guess, s.grid, s.coarse)
+        else:
+            op, gap = s.compliance, s.gap + h
+        if implicit_cycles:
+            op = ImplicitCompliance(op, implicit_cycles, s.stroke, s.k_moving, s.k_stationary)
+        res = solve(op, gap, s.load, method=s.method, p0=guess, tol=s.tolerance)
         if not res.success:
-            raise NumericalFailure(f"the contact solve did not converge at cycle {cycle}: {res.message}", cycle)
+            raise NumericalFailure(f"the contact solve did not converge at cycle {cycle}: {res.message}", self.n)
         if not np.isfinite(res.pressure).all():
-            raise NumericalFailure(f"non-finite pressure at cycle {cycle}", cycle)
-        _check_edges(res.pressure, reach, grid, cycle, setup)
-        return res
+            raise NumericalFailure(f"non-finite pressure at cycle {cycle}", self.n)
+        p = res.pressure if s.coarse is None else refine_pressure(res.pressure, s.coarse, s.grid)
+        _check_edges(p, self.reach, s.grid, cycle, s)
+        return p, res
 
-    res = contact(0, None)
-    try:
-        check_resolution(res, grid.plane_strain)
-    except ValueError as exc:
-        raise CaseError("grid", [("grid.elements", str(exc))]) from None
-    p = res.pressure
-    p_prev, step_prev = None, None
-    n = 0
-    step = _record(setup, 0, h_m, h_s, p, res, t0)
-    for obs in observers:
-        obs.on_step(setup, step)
-    for d_n in linear_schedule(setup.cycles, setup.linear_jump, setup.snapshots):
-        p_av = step.pressure_average
-        dh_m = archard_depth(setup.k_moving, p, d_n, setup.stroke)
-        dh_s = archard_depth(setup.k_stationary, p_av, d_n, setup.stroke)
-        if (dh_m < 0).any() or (dh_s < 0).any():
-            raise NumericalFailure(f"negative wear increment at cycle {n + d_n}", n)
-        h_m = h_m + dh_m
-        h_s = h_s + dh_s
-        n += d_n
-        # predictor: extrapolate the pressure history so the warm start begins closer to the answer
-        guess = p if p_prev is None else np.clip(p + (p - p_prev) * (d_n / step_prev), 0.0, None)
-        p_prev, step_prev = p, d_n
-        res = contact(n, guess)
-        p = res.pressure
-        step = _record(setup, n, h_m, h_s, p, res, t0)
+    def rates(self, p):
+        """Wear per cycle of the moving and the stationary body for pressure p (Eqs. 15-16 with ΔN = 1)."""
+        s = self.s
+        return (archard_depth(s.k_moving, p, 1.0, s.stroke),
+                archard_depth(s.k_stationary, stroke_average(p, s.grid.dx, s.stroke), 1.0, s.stroke))
+
+    def next_stop(self) -> int:
+        return next(t for t in self.stops if t > self.n)
+
+    def emit(self, p, res, jump: int, rejected: int = 0) -> Step:
+        s = self.s
+        step = _record(s, self.n, self.h_m, self.h_s, p, res, self.t0)
+        step.jump, step.rejected = jump, rejected
         if step.archard_error > ARCHARD_ROUND_OFF:
-            raise NumericalFailure(f"the Archard invariant is broken at cycle {n}: wear volume differs from "
-                                   f"k·P·4δ·N by {step.archard_error:.2e} (relative)", n)
-        if is_checkerboard(p):
+            raise NumericalFailure(f"the Archard invariant is broken at cycle {self.n}: wear volume differs from "
+                                   f"k·P·4δ·N by {step.archard_error:.2e} (relative)", self.n)
+        if s.stop_on_checkerboard and self.n > 0 and is_checkerboard(p):
+            what = (f"the linear jump {s.linear_jump} cycles is unstable" if s.scheme == "linear" else
+                    f"the {s.scheme} step of {jump} cycles (linear jump {s.linear_jump}) is unstable")
             raise NumericalFailure(
-                f"the pressure checkerboards at cycle {n}: the linear jump {setup.linear_jump} cycles is unstable "
-                f"for this grid (explicit stability limit {setup.stability_limit:.4g} cycles); reduce "
-                f"jumping.linear or leave it out for the automatic choice", n)
-        for obs in observers:
-            obs.on_step(setup, step)
-        if progress is not None:
-            progress(d_n)
-    return step
+                f"the pressure checkerboards at cycle {self.n}: {what} for this grid (explicit stability limit "
+                f"{s.stability_limit:.4g} cycles); reduce jumping.linear (or jumping.max), leave them out for the "
+                f"automatic choice, or use jumping.scheme: implicit", self.n)
+        for obs in self.observers:
+            obs.on_step(s, step)
+        if self.progress is not None and jump:
+            self.progress(jump)
+        return step
+
+    def advance(self, dh_m, dh_s, d_n: int) -> None:
+        if (dh_m < 0).any() or (dh_s < 0).any():
+            raise NumericalFailure(f"negative wear increment at cycle {self.n + d_n}", self.n)
+        self.h_m = self.h_m + dh_m
+        self.h_s = self.h_s + dh_s
+        self.n += d_n
+
+    def run(self) -> Step:
+        s = self.s
+        p, res = self.contact(0, None)
+        try:
+            check_resolution(res, (s.coarse or s.grid).plane_strain)
+        except ValueError as exc:
+            raise CaseError("grid", [("grid.elements", str(exc))]) from None
+        step = self.emit(p, res, 0)
+        if s.cycles == 0:
+            return step
+        return {"linear": self._linear, "adaptive": self._adaptive, "implicit": self._implicit}[s.scheme](p, step)
+
+    def _explicit_step(self, p, p_prev, d_prev, d_n):
+        r_m, r_s = self.rates(p)
+        self.advance(r_m * d_n, r_s * d_n, d_n)
+        # predictor: extrapolate the pressure history so the warm start begins closer to the answer
+        guess = p if p_prev is None else np.clip(p + (p - p_prev) * (d_n / d_prev), 0.0, None)
+        return self.contact(self.n, guess)
+
+    def _linear(self, p, step) -> Step:
+        p_prev, d_prev = None, 1
+        while self.n < self.s.cycles:
+            d_n = min(self.s.linear_jump, self.next_stop() - self.n)
+            p_new, res = self._explicit_step(p, p_prev, d_prev, d_n)
+            p_prev, d_prev, p = p, d_n, p_new
+            step = self.emit(p, res, d_n)
+        return step
+
+    def _adaptive(self, p, step) -> Step:
+        """Batches of Q_LINEAR linear steps, then a Taylor jump (paper Eqs. 19-21, Fig. 8)."""
+        s = self.s
+        lin = s.linear_jump
+        batch = [(self.h_m, self.h_s)]
+        p_prev, d_prev = None, 1
+        while self.n < s.cycles:
+            room = self.next_stop() - self.n
+            if len(batch) > Q_LINEAR:
+                (m2, s2), (m1, s1), (m0, s0) = batch[-3:]
+                jump = min(taylor_jump([(m2, m1, m0), (s2, s1, s0)], lin, s.eta, s.max_jump or 600), room)
+                while True:  # the quadratic term must not make any increment negative
+                    new_m = taylor_extrapolate(m2, m1, m0, lin, jump)
+                    new_s = taylor_extrapolate(s2, s1, s0, lin, jump)
+                    if jump <= 1 or ((new_m >= m0).all() and (new_s >= s0).all()):
+                        break
+                    jump //= 2
+                self.advance(np.clip(new_m - m0, 0.0, None), np.clip(new_s - s0, 0.0, None), jump)
+                p, res = self.contact(self.n, p)
+                p_prev = None
+                step = self.emit(p, res, jump)
+                batch = [(self.h_m, self.h_s)]
+                continue
+            d_n = min(lin, room)
+            p_new, res = self._explicit_step(p, p_prev, d_prev, d_n)
+            p_prev, d_prev, p = p, d_n, p_new
+            step = self.emit(p, res, d_n)
+            # an interrupted (shortened) step breaks the equal spacing the differences need: restart the batch
+            batch = batch + [(self.h_m, self.h_s)] if d_n == lin else [(self.h_m, self.h_s)]
+        return step
+
+    def _implicit(self, p, step) -> Step:
+        """Backward-Euler wear steps, each a contact solve with C + ΔN·4δ·(k_m I + k_s B), under error control.
+
+        The local error of a backward-Euler step is about (ΔN/2)·(r_{n+1} − r_n) (r the wear rate per cycle);
+        its root-mean-square over the grid, relative to that of the body's depth after the step, must stay
+        below the tolerance, else the step is redone smaller.  (A maximum norm would be ruled by the few
+        elements entering contact at the scar's edge, whose share of the depth error is small.)  Accepted
+        steps grow geometrically while the scar settles.
+        """
+        s = self.s
+        r_old = self.rates(p)
+        jump = float(min(s.linear_jump, s.implicit_cap))
+        rejected = 0
+        p_prev, d_prev = None, 1
+        while self.n < s.cycles:
+            d_n = int(max(1, min(jump, self.next_stop() - self.n, s.implicit_cap, s.max_jump or np.inf)))
+            guess = p if p_prev is None else np.clip(p + (p - p_prev) * (d_n / d_prev), 0.0, None)
+            p_new, res = self.contact(self.n + d_n, guess, implicit_cycles=d_n)
+            r_new = self.rates(p_new)
+            error = 0.0
+            for (old, new), h in zip(zip(r_old, r_new), (self.h_m, self.h_s)):
+                depth = float(np.linalg.norm(h + d_n * new))
+                if depth > 0:
+                    error = max(error, 0.5 * d_n * float(np.linalg.norm(new - old)) / depth)
+            if error > 1.5 * s.step_tolerance and d_n > 1:
+                rejected += 1
+                jump = next_implicit_jump(d_n, error, s.step_tolerance)
+                continue
+            self.advance(r_new[0] * d_n, r_new[1] * d_n, d_n)
+            p_prev, d_prev = p, d_n
+            p, r_old = p_new, r_new
+            step = self.emit(p, res, d_n, rejected)
+            rejected = 0
+            jump = next_implicit_jump(d_n, error, s.step_tolerance)
+        return step
 
 
 def _check_edges(p: np.ndarray, reach: int, grid: Grid, cycle: int, setup: Setup) -> None:

@@ -63,10 +63,10 @@ def test_2d_centre_line_agrees_with_3d_within_the_end_load_share(name):
 
 
 def test_halving_the_jump_and_the_element_size_changes_the_depth_by_under_1pct():
-    base = summary_of("mccoll_185N", "2d")
+    base = summary_of("mccoll_185N", "2d", "jumping.scheme=linear")
     nx = base["elements_x"]
     domain = nx * base["element_size_x_um"] * 1e-3
-    fine = summary_of("mccoll_185N", "2d", f"jumping.linear={base['linear_jump'] // 2}",
+    fine = summary_of("mccoll_185N", "2d", "jumping.scheme=linear", f"jumping.linear={base['linear_jump'] // 2}",
                       f"grid.domain=[{domain!r} mm]", f"grid.elements=[{2 * nx}]")
     assert fine["element_size_x_um"] == pytest.approx(base["element_size_x_um"] / 2)
     assert fine["centre_wear_depth_stationary_um"] == pytest.approx(base["centre_wear_depth_stationary_um"],
@@ -155,10 +155,10 @@ def test_wear_loop_with_the_papers_msm_matches_cg():
 
 @pytest.mark.slow
 def test_3d_halving_the_jump_and_the_element_size_changes_the_depth_by_under_1pct():
-    base = summary_of("mccoll_185N", "3d")
+    base = summary_of("mccoll_185N", "3d", "jumping.scheme=linear")
     nx, ny = base["elements_x"], base["elements_y"]
     domain = nx * base["element_size_x_um"] * 1e-3
-    fine = summary_of("mccoll_185N", "3d", f"jumping.linear={base['linear_jump'] // 2}",
+    fine = summary_of("mccoll_185N", "3d", "jumping.scheme=linear", f"jumping.linear={base['linear_jump'] // 2}",
                       f"grid.domain=[{domain!r} mm, 10 mm]", f"grid.elements=[{2 * nx}, {ny}]")
     assert fine["centre_wear_depth_stationary_um"] == pytest.approx(base["centre_wear_depth_stationary_um"],
                                                                     rel=CONVERGED)

@@ -53,6 +53,7 @@ def solve_cg(compliance: Compliance, gap: np.ndarray, load: float, p0: Optional[
         tau = float(np.dot(g[on], t[on])) / denom
         p_old = p
         trial = p - tau * t
+        clipped = bool((trial < 0.0).any())
         p = np.clip(trial, 0.0, None)
         overlap = (p == 0.0) & (g < 0.0) & allowed
         if overlap.any():
@@ -62,9 +63,10 @@ def solve_cg(compliance: Compliance, gap: np.ndarray, load: float, p0: Optional[
             delta = 1.0
         scale = total / p.sum()
         p *= scale
-        # While the contact set is unchanged p is linear in t, so is u: one FFT per iteration instead of two.
-        # A changed set (clipped or added elements) or every 20th step recomputes u exactly.
-        if it % 20 == 0 or not np.array_equal(p > 0, on):
+        # Without clipping or added elements p is linear in t, and so is u: one FFT per iteration instead of
+        # two.  Otherwise (an element may be clipped and re-added in one step, leaving the set unchanged but p
+        # not linear in t), and every 20th step against round-off, u is recomputed exactly.
+        if clipped or delta == 0.0 or it % 20 == 0:
             u = compliance(p)
         else:
             u = scale * (u - tau * r_raw)
