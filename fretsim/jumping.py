@@ -98,25 +98,36 @@ def checkerboard_amplitude(pressure: np.ndarray, edge: int = 3) -> float:
     while the smooth part and isolated features such as edge peaks give r of no consistent sign, which
     averages out.  The contact is taken where p exceeds 5 % of the row's peak (refined pressures have low
     tails), and elements within ``edge`` of its edges are left out (the pressure is not smooth there).
-    Returns the worst row.
+    Returns the worst row with at least 6 interior elements.
     """
-    worst = 0.0
-    for row in np.atleast_2d(pressure):
-        on = np.flatnonzero(row > 0.05 * row.max()) if row.max() > 0 else np.array([], int)
-        if on.size < 2 * edge + 6:
-            continue
-        seg = row[on[0] + edge:on[-1] + 1 - edge]
-        d2 = seg[:-2] - 2 * seg[1:-1] + seg[2:]
-        r = d2 * (1.0 - 2.0 * (np.arange(d2.size) % 2)) / 4.0
-        mean = float(seg.mean())
-        if mean > 0:
-            worst = max(worst, abs(float(r.mean())) / mean)
-    return worst
+    p = np.atleast_2d(pressure)
+    peak = p.max(axis=1, keepdims=True)
+    on = p > 0.05 * peak
+    # interior: the span from the first to the last element in contact, less `edge` (and the stencil) at each
+    # end; a span, not the mask, because a strong checkerboard has near-zero elements inside the contact
+    idx = np.arange(p.shape[1])
+    first = np.argmax(on, axis=1)[:, None]
+    last = (p.shape[1] - 1 - np.argmax(on[:, ::-1], axis=1))[:, None]
+    interior = (idx >= first + edge + 1) & (idx <= last - edge - 1) & on.any(axis=1, keepdims=True)
+    d2 = np.zeros_like(p)
+    d2[:, 1:-1] = p[:, :-2] - 2 * p[:, 1:-1] + p[:, 2:]
+    r = d2 * (1.0 - 2.0 * (np.arange(p.shape[1]) % 2)) / 4.0
+    count = interior.sum(axis=1)
+    rows = count >= 6
+    if not rows.any():
+        return 0.0
+    mean_r = (r * interior).sum(axis=1)[rows] / count[rows]
+    mean_p = (p * interior).sum(axis=1)[rows] / count[rows]
+    return float((np.abs(mean_r) / mean_p).max())
 
 
 def is_checkerboard(pressure: np.ndarray) -> bool:
     """True when the pressure oscillates from element to element along x (an unstable explicit update)."""
     return checkerboard_amplitude(pressure) > CHECKERBOARD_LIMIT
+
+
+def is_checkerboard_amplitude(amplitude: float) -> bool:
+    return amplitude > CHECKERBOARD_LIMIT
 
 
 # --- adaptive cycle jumping (paper section 2.2.3, Eqs. 19–21) ---------------------------------------------------

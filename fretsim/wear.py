@@ -8,18 +8,23 @@ contributes its pressure times the length of its overlap with the window.
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 from scipy.ndimage import convolve1d
 
 
+@lru_cache(maxsize=64)
 def stroke_weights(dx: float, stroke: float) -> np.ndarray:
-    """Weights w_k (k = −K..K) with p_av,i = Σ w_k p_{i−k}; they sum to 1."""
+    """Weights w_k (k = −K..K) with p_av,i = Σ w_k p_{i−k}; they sum to 1.  Cached: treat as read-only."""
     if not (dx > 0 and stroke > 0):
         raise ValueError(f"element size and stroke must be positive, got {dx}, {stroke}")
     reach = int(np.ceil(stroke / dx + 0.5))
     centres = np.arange(-reach, reach + 1) * dx
     overlap = np.clip(np.minimum(centres + dx / 2, stroke) - np.maximum(centres - dx / 2, -stroke), 0.0, None)
-    return overlap / (2.0 * stroke)
+    weights = overlap / (2.0 * stroke)
+    weights.flags.writeable = False
+    return weights
 
 
 def stroke_average(pressure: np.ndarray, dx: float, stroke: float) -> np.ndarray:

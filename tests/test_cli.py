@@ -63,7 +63,7 @@ def test_existing_results_are_not_overwritten(cli, tmp_path):
 
 def test_failed_run_exits_3_and_marks_the_file(cli, tmp_path):
     r = cli.invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), "-o", "f.h5", "--set", "model.dimension=2d",
-                          "--set", "jumping.linear=80"])
+                          "--set", "jumping.linear=40"])
     assert r.exit_code == 3 and "checkerboard" in r.output
     assert json.loads(cli.invoke(main, ["summary", "f.h5", "--json"]).output)["status"] == "failed"
 
@@ -78,3 +78,8 @@ def test_summary_of_a_non_results_file_is_a_clear_error(cli, tmp_path):
     (tmp_path / "junk.h5").write_text("not hdf5")
     r = cli.invoke(main, ["summary", "junk.h5"])
     assert r.exit_code == 2 and "not a readable HDF5" in r.output
+
+
+def test_linear_jump_beyond_the_limit_exits_2_with_the_limit(cli, tmp_path):
+    r = cli.invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), "-o", "u.h5", "--set", "jumping.linear=80"])
+    assert r.exit_code == 2 and "stability limit" in r.output and not (tmp_path / "u.h5").exists()

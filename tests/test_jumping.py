@@ -63,3 +63,11 @@ def test_detector_flags_a_checkerboard_and_not_hertz_or_edge_peaks():
     assert not is_checkerboard(hertz) and not is_checkerboard(edge_peaked)
     assert is_checkerboard(chequered)
     assert checkerboard_amplitude(chequered) == pytest.approx(0.03, rel=0.2)
+
+
+def test_detector_flags_a_strong_checkerboard_whose_troughs_touch_zero():
+    # an unstable run's pressure swings between ~0 and twice its mean: the troughs must not hide the contact
+    x = np.linspace(-1, 1, 41)
+    smooth = np.where(np.abs(x) < 0.9, 200.0, 0.0)
+    strong = smooth * (1 + 0.98 * (-1.0) ** np.arange(41))
+    assert is_checkerboard(strong[None, :])
