@@ -291,7 +291,7 @@ def _validate(raw: dict, problems: list, source: str, default_name: str) -> Opti
     length = None
     if gtype == "cylinder_on_flat":
         length = r.quantity(geo, "length", "geometry", "length")
-    elif gtype == "ball_on_flat" and "length" in geo:
+    elif gtype == "ball_on_flat" and geo.get("length") is not None:
         r.fail("geometry.length", "a ball has no axial length; remove this key")
 
     mats = r.section(raw, "materials", SECTIONS["materials"])
