@@ -1,4 +1,4 @@
-"""The Python API the CLI wraps: load a case, run it, read the results.
+"""The Python API the CLI wraps: load a case, run it (or resume it), read the results.
 
     >>> from fretsim.api import load_case, run, read_results
     >>> outcome = run(load_case("cases/mccoll_185N.yaml"), "out.h5")
@@ -13,15 +13,17 @@ from typing import Callable, Optional
 
 from fretsim.case import Case, CaseError, load_case, parse_case
 from fretsim.results import Results, ResultsWriter, read_results
-from fretsim.simulate import SimulationError, Setup, Step, prepare, simulate, summarize
+from fretsim.simulate import PhysicalLimit, SimulationError, Setup, Step, prepare, simulate, summarize
 
 __all__ = ["Case", "CaseError", "Outcome", "Results", "SimulationError", "load_case", "parse_case", "read_results",
-           "run"]
+           "run", "resume"]
+
+RESUMABLE = ("interrupted", "running")  # "running": the process was killed before it could say otherwise
 
 
 @dataclass
 class Outcome:
-    status: str  # complete | interrupted | failed
+    status: str  # complete | interrupted | failed | stopped (a physical limit was reached)
     message: str
     summary: dict
     setup: Setup
@@ -32,8 +34,8 @@ class Outcome:
 
 
 class _Counter:
-    def __init__(self):
-        self.solves = 0
+    def __init__(self, solves: int = 0):
+        self.solves = solves
         self.last = None
 
     def on_step(self, setup, step):
@@ -45,46 +47,76 @@ def run(case: Case, output: Optional[str | Path] = None, *, overwrite: bool = Fa
         progress: Optional[Callable[[int], None]] = None, observers: tuple = ()) -> Outcome:
     """Run a case; write the results file if ``output`` is given.
 
-    Raises :class:`CaseError` for a case that cannot be set up (nothing is
-    written then).  A run that fails or is interrupted returns an outcome with
-    that status after marking the file; KeyboardInterrupt is re-raised after
-    the file is closed.
+    Raises :class:`CaseError` for a case that cannot be set up (nothing is written then).  A run that fails,
+    stops at a physical limit or is interrupted returns an outcome with that status after writing the file;
+    KeyboardInterrupt is re-raised after the file is written with status ``interrupted``.
     """
     setup, filled = prepare(case)
     if output is not None and Path(output).exists() and not overwrite:
-        raise CaseError(str(output), [("", "the results file exists already; choose another -o or pass "
-                                           "--overwrite")])
-    counter = _Counter()
+        raise CaseError(str(output), [("", "the results file exists already; choose another -o, pass "
+                                           "--overwrite, or --resume it")])
+    return _execute(setup, filled, output, overwrite, progress, observers, resume_from=None)
+
+
+def resume(output: str | Path, *, progress: Optional[Callable[[int], None]] = None,
+           observers: tuple = ()) -> Outcome:
+    """Continue an interrupted (or killed) run from the last state in its results file.
+
+    The case is the one stored in the file, so the run continues exactly as it would have: the same steps,
+    the same arrays.
+    """
+    previous = read_results(output)
+    if previous.status not in RESUMABLE:
+        raise CaseError(str(output), [("", f"the run's status is {previous.status!r}; only an interrupted or "
+                                           f"killed run ({' or '.join(RESUMABLE)}) can be resumed")])
+    if not previous.checkpoint:
+        raise CaseError(str(output), [("", "the file holds no checkpoint to resume from (it was written before "
+                                           "the first step completed); run the case again")])
+    case = parse_case(previous.case_yaml, source=f"{output}:/case")
+    setup, filled = prepare(case)
+    return _execute(setup, filled, output, True, progress, observers, resume_from=previous)
+
+
+def _execute(setup, filled, output, overwrite, progress, observers, resume_from: Optional[Results]) -> Outcome:
+    counter = _Counter(len(resume_from.history["cycle"]) if resume_from is not None else 0)
     writer = None
     t0 = time.perf_counter()
 
     class _LazyWriter:
-        """Opens the file at the first accepted step, so a case that fails its first solve writes nothing."""
+        """Creates the file at the first accepted step, so a case that fails its first solve writes nothing."""
 
         def on_step(self, setup_, step):
             nonlocal writer
             if writer is None and output is not None:
-                writer = ResultsWriter(output, filled.to_yaml(), filled.name, setup.grid, setup.notes, overwrite)
+                writer = ResultsWriter(output, filled.to_yaml(), filled.name, setup.grid, setup.notes, overwrite,
+                                       previous=resume_from)
             if writer is not None:
                 writer.on_step(setup_, step)
 
     status, message = "complete", ""
+    state = resume_from.checkpoint if resume_from is not None else None
     try:
-        simulate(setup, (counter, _LazyWriter()) + tuple(observers), progress)
+        simulate(setup, (counter, _LazyWriter()) + tuple(observers), progress, resume=state)
+    except PhysicalLimit as exc:
+        status, message = "stopped", str(exc)
     except SimulationError as exc:
         status, message = "failed", str(exc)
     except KeyboardInterrupt:
-        status, message = "interrupted", f"interrupted at cycle {counter.last.cycle if counter.last else 0}"
-        _close(writer, setup, counter, t0, status, message)
+        cycle = counter.last.cycle if counter.last else (int(state["n"]) if state else 0)
+        _finish(writer, setup, counter, t0, "interrupted", f"interrupted after cycle {cycle}; resume with "
+                                                           f"`fretsim run --resume {output}`")
         raise
-    summary = summarize(setup, counter.last, counter.solves, time.perf_counter() - t0) if counter.last else {}
-    if writer is not None:
-        writer.finish(status, message, summary)
+    _finish(writer, setup, counter, t0, status, message)
+    summary = summarize(setup, counter.last, counter.solves, _elapsed(counter, t0)) if counter.last else {}
     return Outcome(status, message, summary, setup, filled, Path(output) if output else None, counter.last,
                    setup.notes)
 
 
-def _close(writer, setup, counter, t0, status, message):
+def _elapsed(counter, t0) -> float:
+    return float(counter.last.state.get("elapsed", time.perf_counter() - t0)) if counter.last else 0.0
+
+
+def _finish(writer, setup, counter, t0, status, message):
     if writer is not None:
-        summary = summarize(setup, counter.last, counter.solves, time.perf_counter() - t0) if counter.last else {}
+        summary = summarize(setup, counter.last, counter.solves, _elapsed(counter, t0)) if counter.last else {}
         writer.finish(status, message, summary)

@@ -34,6 +34,7 @@ SECTIONS = {
 }
 MATERIAL_KEYS = {"youngs_modulus", "poissons_ratio", "wear_coefficient"}
 MAX_CYCLES = 10**10
+LENGTH_RANGE = (1e-3, 1e4, "1 µm to 10 m")
 
 
 class CaseError(Exception):
@@ -219,7 +220,7 @@ class _Reader:
                     f" (did you mean '{hint[0]}'?)" if hint else f"; allowed: {', '.join(sorted(keys))}"))
 
     def quantity(self, mapping: dict, key: str, prefix: str, dimension: str, required: bool = True,
-                 positive: bool = True) -> Optional[float]:
+                 positive: bool = True, plausible: Optional[tuple[float, float, str]] = None) -> Optional[float]:
         path = f"{prefix}.{key}"
         if key not in mapping or mapping[key] is None:
             if required:
@@ -232,6 +233,10 @@ class _Reader:
             return None
         if positive and not v > 0:
             self.fail(path, f"must be positive, got {mapping[key]!r}")
+            return None
+        if plausible is not None and not plausible[0] <= v <= plausible[1]:
+            self.fail(path, f"{mapping[key]!r} is outside the plausible range {plausible[2]} for a fretting contact: "
+                            f"check the value and its unit")
             return None
         return v
 
@@ -287,10 +292,10 @@ def _validate(raw: dict, problems: list, source: str, default_name: str) -> Opti
 
     geo = r.section(raw, "geometry", SECTIONS["geometry"])
     gtype = r.choice(geo, "type", "geometry.type", GEOMETRIES) if geo else None
-    radius = r.quantity(geo, "radius", "geometry", "length") if geo else None
+    radius = r.quantity(geo, "radius", "geometry", "length", plausible=LENGTH_RANGE) if geo else None
     length = None
     if gtype == "cylinder_on_flat":
-        length = r.quantity(geo, "length", "geometry", "length")
+        length = r.quantity(geo, "length", "geometry", "length", plausible=LENGTH_RANGE)
     elif gtype == "ball_on_flat" and geo.get("length") is not None:
         r.fail("geometry.length", "a ball has no axial length; remove this key")
 
@@ -306,12 +311,13 @@ def _validate(raw: dict, problems: list, source: str, default_name: str) -> Opti
                    if m is None else f"expected a mapping, got a {type(m).__name__}")
             continue
         r.unknown(m, MATERIAL_KEYS, path)
-        e = r.quantity(m, "youngs_modulus", path, "pressure")
+        e = r.quantity(m, "youngs_modulus", path, "pressure", plausible=(1.0, 1e7, "1 MPa to 10 TPa"))
         nu = r.number(m, "poissons_ratio", f"{path}.poissons_ratio", -1.0, 0.5, open_hi=True)
         if nu is not None and nu <= -1.0:
             r.fail(f"{path}.poissons_ratio", "must be greater than -1")
             nu = None
-        k = r.quantity(m, "wear_coefficient", path, "wear_coefficient", positive=False)
+        k = r.quantity(m, "wear_coefficient", path, "wear_coefficient", positive=False,
+                       plausible=(0.0, 1e-3, "0 to 1e-3 1/MPa"))
         if k is not None and k < 0:
             r.fail(f"{path}.wear_coefficient", f"must not be negative, got {m['wear_coefficient']!r}")
             k = None
@@ -319,8 +325,10 @@ def _validate(raw: dict, problems: list, source: str, default_name: str) -> Opti
             materials[body] = Material(e, nu, k)
 
     load = r.section(raw, "loading", SECTIONS["loading"])
-    normal_load = r.quantity(load, "normal_load", "loading", "force") if load else None
-    stroke = r.quantity(load, "stroke", "loading", "length") if load else None
+    normal_load = r.quantity(load, "normal_load", "loading", "force", plausible=(1e-6, 1e7, "1 µN to 10 MN")) \
+        if load else None
+    stroke = r.quantity(load, "stroke", "loading", "length", plausible=(1e-6, 10.0, "1 nm to 10 mm")) \
+        if load else None
     cycles = None
     if load:
         if "cycles" not in load:

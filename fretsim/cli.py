@@ -1,7 +1,7 @@
 """`fretsim` command line: run, summary, plot.  No algorithm here: it wraps :mod:`fretsim.api`.
 
 Exit codes: 0 complete, 2 bad input (case, options, files), 3 a run that failed numerically or outgrew its grid,
-130 interrupted.
+4 a run stopped at a physical limit (a body worn through), 130 interrupted (resume with --resume).
 """
 from __future__ import annotations
 
@@ -14,6 +14,7 @@ import click
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILED = 3
+EXIT_STOPPED = 4
 EXIT_INTERRUPTED = 130
 
 
@@ -31,38 +32,68 @@ def main() -> None:
 
 
 @main.command()
-@click.argument("case_file", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("case_file", required=False, type=click.Path(dir_okay=False, path_type=Path))
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="Results file (default: CASE_FILE's name with .h5, in the current directory).")
 @click.option("--set", "overrides", multiple=True, metavar="KEY.PATH=VALUE",
               help="Override a case value, e.g. --set loading.cycles=1000 (repeatable).")
 @click.option("--overwrite", is_flag=True, help="Replace an existing results file.")
+@click.option("--resume", "resume_file", type=click.Path(dir_okay=False, path_type=Path),
+              help="Continue an interrupted run from its results file (no CASE_FILE then).")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
-def run(case_file: Path, output: Path | None, overrides: tuple, overwrite: bool, debug: bool) -> None:
-    """Run CASE_FILE and write an HDF5 results file."""
-    from fretsim.api import CaseError, load_case, run as run_case
+def run(case_file: Path | None, output: Path | None, overrides: tuple, overwrite: bool, resume_file: Path | None,
+        debug: bool) -> None:
+    """Run CASE_FILE and write an HDF5 results file (or --resume one)."""
+    import signal
 
-    output = output or Path(case_file.stem + ".h5")
+    from fretsim.api import CaseError, load_case, resume as resume_run, run as run_case
+
+    if resume_file is not None and (case_file is not None or overrides or output is not None):
+        _fail("--resume takes the results file alone: the case, grid and settings are the ones stored in it",
+              EXIT_BAD_INPUT, debug)
+    if resume_file is None and case_file is None:
+        _fail("give a CASE_FILE to run, or --resume RESULTS_FILE", EXIT_BAD_INPUT, debug)
+    output = resume_file or output or Path(case_file.stem + ".h5")
+
+    def _terminate(signum, frame):  # SIGTERM ends a run as cleanly as Ctrl-C
+        raise KeyboardInterrupt
+
+    previous_handler = signal.signal(signal.SIGTERM, _terminate)
     try:
-        case = load_case(case_file, list(overrides))
+        if resume_file is not None:
+            total, start = None, 0
+        else:
+            case = load_case(case_file, list(overrides))
+            total, start = case.cycles, 0
         bar = None
-        if sys.stderr.isatty() and case.cycles > 0:
-            bar = click.progressbar(length=case.cycles, label=f"{case.name}", file=sys.stderr, show_eta=True)
+        if sys.stderr.isatty() and total:
+            bar = click.progressbar(length=total, label="fretsim", file=sys.stderr, show_eta=True)
             bar.__enter__()
+            bar.update(start)
         try:
-            outcome = run_case(case, output, overwrite=overwrite, progress=bar.update if bar else None)
+            if resume_file is not None:
+                outcome = resume_run(resume_file, progress=bar.update if bar else None)
+            else:
+                outcome = run_case(case, output, overwrite=overwrite, progress=bar.update if bar else None)
         finally:
             if bar is not None:
                 bar.__exit__(None, None, None)
     except CaseError as exc:
         _fail(str(exc), EXIT_BAD_INPUT, debug)
+    except ValueError as exc:  # an unreadable results file for --resume
+        _fail(str(exc), EXIT_BAD_INPUT, debug)
     except KeyboardInterrupt:
-        _fail(f"interrupted; every accepted step so far is in {output} (status 'interrupted')", EXIT_INTERRUPTED,
-              debug)
+        _fail(f"interrupted; every accepted step so far is in {output} (status 'interrupted'); continue with "
+              f"`fretsim run --resume {output}`", EXIT_INTERRUPTED, debug)
     except OSError as exc:
         _fail(f"cannot write {output}: {exc}", EXIT_BAD_INPUT, debug)
+    finally:
+        signal.signal(signal.SIGTERM, previous_handler)
     for note in outcome.notes:
         click.echo(f"note: {note}", err=True)
+    if outcome.status == "stopped":
+        click.echo(_paragraph(outcome))
+        _fail(f"stopped at a physical limit: {outcome.message}", EXIT_STOPPED, debug)
     if outcome.status != "complete":
         _fail(f"run failed: {outcome.message}" + (f"; steps up to the failure are in {output} (status 'failed')"
                                                   if outcome.last is not None else ""), EXIT_FAILED, debug)

@@ -1,19 +1,22 @@
-"""The HDF5 results file: layout, incremental writer and reader.  The layout is a contract (see README).
+"""The HDF5 results file: layout, crash-safe writer and reader.  The layout is a contract (see README).
 
-    /                  attrs format_version, fretsim_version, status, status_message, case_name
+    /                  attrs format_version, fretsim_version, status, status_message, case_name, notes
     /case              the validated case with defaults and automatic choices filled (YAML text)
     /grid/x, /grid/y   element centres (mm)
     /history/<name>    one entry per accepted step (cycle, wear depths, volumes, pressure, iterations, time…)
     /fields/<name>     at the snapshot cycles: wear depths, pressure, stroke-averaged pressure (S, My, Mx)
     /summary           attrs: the run's headline figures (same names as `fretsim summary`)
+    /checkpoint        the loop's state at the last written step, for `fretsim run --resume`
 
-History rows are written in batches and the file flushed at least every 0.5 s and at every snapshot, so
-it is readable during a run; an interrupted run keeps every step it accepted, a killed one all but the
-last half second.
+Crash safety: the writer keeps the run in memory and, at every flush, writes the whole file to a temporary
+file beside it and renames it over the results file (an atomic replacement on POSIX).  The file on disk is
+therefore always a complete, valid HDF5 file — after Ctrl-C, SIGTERM or kill -9 alike — holding every step
+up to the last flush (at most FLUSH_SECONDS old) together with the state to resume from.
 """
 from __future__ import annotations
 
 import math
+import os
 import time
 from dataclasses import dataclass
 from pathlib import Path
@@ -24,7 +27,8 @@ import numpy as np
 
 from fretsim import __version__
 
-FORMAT_VERSION = "1.0"
+FORMAT_VERSION = "1.1"
+FLUSH_SECONDS = 0.5
 
 # name: (units, how to get the value from a Step)
 HISTORY = {
@@ -43,6 +47,7 @@ HISTORY = {
     "cycle_jump": ("cycles", lambda s: s.jump),
     "rejected_steps": ("1", lambda s: s.rejected),
 }
+INTEGER_HISTORY = {"cycle", "solver_iterations", "cycle_jump", "rejected_steps"}
 FIELDS = {
     "wear_depth_moving": ("um", lambda s: s.wear_moving * 1e3),
     "wear_depth_stationary": ("um", lambda s: s.wear_stationary * 1e3),
@@ -60,75 +65,90 @@ SUMMARY_UNITS = {
 
 
 class ResultsWriter:
-    """Observer that writes each accepted step; create with the filled case, grid and the output path."""
+    """Observer that records each accepted step and keeps the results file complete on disk.
 
-    def __init__(self, path: str | Path, case_yaml: str, case_name: str, grid, notes=(), overwrite: bool = False):
+    ``previous`` (a :class:`Results` read back from an interrupted run) seeds the history and fields, so a
+    resumed run appends to what was there.
+    """
+
+    def __init__(self, path: str | Path, case_yaml: str, case_name: str, grid, notes=(), overwrite: bool = False,
+                 previous: Optional["Results"] = None):
         self.path = Path(path)
-        self._f = h5py.File(self.path, "w" if overwrite else "w-")
-        f = self._f
-        f.attrs.update(format_version=FORMAT_VERSION, fretsim_version=__version__, status="running",
-                       status_message="", case_name=case_name, notes="\n".join(notes))
-        f.create_dataset("case", data=case_yaml, dtype=h5py.string_dtype())
-        g = f.create_group("grid")
-        for name, values in (("x", grid.x), ("y", grid.y)):
-            ds = g.create_dataset(name, data=values)
-            ds.attrs["units"] = "mm"
-        g.attrs.update(dx_mm=grid.dx, dy_mm=grid.dy, plane_strain=grid.plane_strain)
-        h = f.create_group("history")
-        for name, (units, _) in HISTORY.items():
-            ds = h.create_dataset(name, shape=(0,), maxshape=(None,), chunks=(1024,),
-                                  dtype="i8" if name in ("cycle", "solver_iterations", "cycle_jump", "rejected_steps") else "f8")
-            ds.attrs["units"] = units
-        fl = f.create_group("fields")
-        ny, nx = grid.shape
-        ds = fl.create_dataset("cycle", shape=(0,), maxshape=(None,), dtype="i8", chunks=(64,))
-        ds.attrs["units"] = "cycles"
-        for name, (units, _) in FIELDS.items():
-            ds = fl.create_dataset(name, shape=(0, ny, nx), maxshape=(None, ny, nx), chunks=(1, ny, nx), dtype="f8")
-            ds.attrs["units"] = units
-        f.create_group("summary")
-        f.flush()
-        self._rows: list = []
-        self._flushed = time.monotonic()
-
-    FLUSH_SECONDS = 0.5  # history rows are written in batches: a kill loses at most this much of the run
+        if self.path.exists() and not overwrite and previous is None:
+            raise FileExistsError(f"{self.path} exists")
+        self.case_yaml, self.case_name, self.grid, self.notes = case_yaml, case_name, grid, tuple(notes)
+        if previous is not None:
+            self.rows = [list(r) for r in zip(*(previous.history[k] for k in HISTORY))] if len(
+                previous.history.get("cycle", [])) else []
+            self.fields = {k: list(previous.fields[k]) for k in FIELDS}
+            self.field_cycles = list(previous.fields["cycle"])
+        else:
+            self.rows, self.fields, self.field_cycles = [], {k: [] for k in FIELDS}, []
+        self.status, self.message, self.summary = "running", "", {}
+        self.state: Optional[dict] = None
+        self._flushed = -math.inf
 
     def on_step(self, setup, step) -> None:
-        self._rows.append([get(step) for _, get in HISTORY.values()])
-        if step.is_snapshot:
-            fl = self._f["fields"]
-            k = fl["cycle"].shape[0]
-            fl["cycle"].resize((k + 1,))
-            fl["cycle"][k] = step.cycle
+        self.rows.append([get(step) for _, get in HISTORY.values()])
+        if step.is_snapshot and (not self.field_cycles or self.field_cycles[-1] != step.cycle):
+            self.field_cycles.append(step.cycle)
             for name, (_, get) in FIELDS.items():
-                fl[name].resize((k + 1,) + fl[name].shape[1:])
-                fl[name][k] = get(step)
-        if step.is_snapshot or time.monotonic() - self._flushed > self.FLUSH_SECONDS:
-            self._write_rows()
-
-    def _write_rows(self) -> None:
-        if self._rows:
-            h = self._f["history"]
-            n = h["cycle"].shape[0]
-            rows = np.array(self._rows, dtype=float)
-            for j, name in enumerate(HISTORY):
-                h[name].resize((n + len(rows),))
-                h[name][n:] = rows[:, j]
-            self._rows = []
-        self._f.flush()
-        self._flushed = time.monotonic()
+                self.fields[name].append(np.array(get(step)))
+        self.state = step.state
+        if step.is_snapshot or len(self.rows) == 1 or time.monotonic() - self._flushed > FLUSH_SECONDS:
+            self.flush()
 
     def finish(self, status: str, message: str = "", summary: Optional[dict] = None) -> None:
-        self._write_rows()
-        if summary:
-            s = self._f["summary"]
-            for key, value in summary.items():
-                s.attrs[key] = value
-            s.attrs["units"] = ", ".join(f"{k}: {SUMMARY_UNITS.get(k, '1')}" for k in summary)
-        self._f.attrs["status"] = status
-        self._f.attrs["status_message"] = message
-        self._f.flush()
-        self._f.close()
+        self.status, self.message = status, message
+        self.summary = summary or {}
+        self.flush()
+
+    def flush(self) -> None:
+        """Write the whole file beside the target and rename it over the target (atomic)."""
+        tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
+        try:
+            with h5py.File(tmp, "w") as f:
+                self._write(f)
+            os.replace(tmp, self.path)
+        finally:
+            if tmp.exists():
+                tmp.unlink()
+        self._flushed = time.monotonic()
+
+    def _write(self, f: h5py.File) -> None:
+        grid = self.grid
+        f.attrs.update(format_version=FORMAT_VERSION, fretsim_version=__version__, status=self.status,
+                       status_message=self.message, case_name=self.case_name, notes="\n".join(self.notes))
+        f.create_dataset("case", data=self.case_yaml, dtype=h5py.string_dtype())
+        g = f.create_group("grid")
+        for name, values in (("x", grid.x), ("y", grid.y)):
+            g.create_dataset(name, data=values).attrs["units"] = "mm"
+        g.attrs.update(dx_mm=grid.dx, dy_mm=grid.dy, plane_strain=grid.plane_strain)
+        h = f.create_group("history")
+        rows = np.array(self.rows, dtype=float).reshape(len(self.rows), len(HISTORY))
+        for j, (name, (units, _)) in enumerate(HISTORY.items()):
+            data = rows[:, j].astype("i8") if name in INTEGER_HISTORY else rows[:, j]
+            h.create_dataset(name, data=data).attrs["units"] = units
+        fl = f.create_group("fields")
+        ny, nx = grid.shape
+        fl.create_dataset("cycle", data=np.array(self.field_cycles, dtype="i8")).attrs["units"] = "cycles"
+        for name, (units, _) in FIELDS.items():
+            data = np.array(self.fields[name]).reshape(len(self.fields[name]), ny, nx)
+            fl.create_dataset(name, data=data).attrs["units"] = units
+        s = f.create_group("summary")
+        for key, value in self.summary.items():
+            s.attrs[key] = value
+        if self.summary:
+            s.attrs["units"] = ", ".join(f"{k}: {SUMMARY_UNITS.get(k, '1')}" for k in self.summary)
+        if self.state is not None:
+            c = f.create_group("checkpoint")
+            for key, value in self.state.items():
+                if isinstance(value, np.ndarray):
+                    c.create_dataset(key, data=value)
+                elif isinstance(value, list):  # a list of arrays (the adaptive scheme's batch)
+                    c.create_dataset(key, data=np.array(value)) if value else c.attrs.__setitem__(key + "_empty", 1)
+                elif value is not None:
+                    c.attrs[key] = value
 
 
 @dataclass
@@ -144,6 +164,7 @@ class Results:
     fields: dict
     summary: dict
     units: dict
+    checkpoint: Optional[dict] = None
 
     @property
     def status(self) -> str:
@@ -165,12 +186,21 @@ def read_results(path: str | Path) -> Results:
             for k, ds in f["fields"].items():
                 fields[k] = ds[()]
                 units[f"fields/{k}"] = ds.attrs.get("units", "")
+            checkpoint = None
+            if "checkpoint" in f:
+                c = f["checkpoint"]
+                checkpoint = {k: ds[()] for k, ds in c.items()}
+                for k, v in c.attrs.items():
+                    if k.endswith("_empty"):
+                        checkpoint[k[:-6]] = []
+                    else:
+                        checkpoint[k] = _plain(v)
             case = f["case"][()]
             return Results(path=str(path), attrs={k: _plain(v) for k, v in f.attrs.items()},
                            case_yaml=case.decode() if isinstance(case, bytes) else str(case),
                            x=f["grid/x"][()], y=f["grid/y"][()], history=history, fields=fields,
                            summary={k: _plain(v) for k, v in f["summary"].attrs.items() if k != "units"},
-                           units=units)
+                           units=units, checkpoint=checkpoint)
     except FileNotFoundError:
         raise ValueError(f"{path}: no such results file") from None
     except OSError as exc:

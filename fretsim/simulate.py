@@ -8,6 +8,7 @@ consistent.
 """
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass, field
 from typing import Callable, Optional, Protocol
@@ -29,6 +30,8 @@ from fretsim.solvers import check_resolution, solve
 from fretsim.wear import archard_depth, archard_volume, stroke_average, stroke_weights
 
 ARCHARD_ROUND_OFF = 1e-9
+MAX_STROKE_OVER_CONTACT = 50.0  # δ/a beyond this is sliding, not fretting, or a unit slip (µm → mm)
+MEMORY_SHARE = 0.5  # refuse a grid that would take more than this share of the machine's memory
 # A Taylor jump is accepted only if it leaves the odd-even pressure amplitude below half the failure threshold:
 # the linear steps that follow damp only the shortest waves strongly, so a jump gets no benefit of the doubt.
 JUMP_ACCEPT = 0.5  # the volume is k·P·4δ·N by construction; anything larger is a bug
@@ -81,6 +84,7 @@ class Setup:
     coarse_compliance: Optional[Compliance] = None
     coarse_gap: Optional[np.ndarray] = None
     stop_on_checkerboard: bool = True
+    body_radius: float = 0.0  # mm: the moving body is worn through when its wear reaches this
     notes: tuple[str, ...] = ()
 
 
@@ -101,11 +105,28 @@ class Step:
     volume_stationary: float = 0.0
     archard_error: float = 0.0
     checkerboard: float = 0.0  # odd-even pressure amplitude / mean pressure
-    extra: dict = field(default_factory=dict)
+    state: dict = field(default_factory=dict)  # the loop's checkpoint after this step (for resuming)
 
 
 class Observer(Protocol):
     def on_step(self, setup: Setup, step: Step) -> None: ...
+
+
+def available_memory() -> int:
+    """Physical memory of this machine in bytes."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return 8 * 2**30
+
+
+def memory_estimate(elements: int, snapshots: int, solver: str) -> float:
+    """Bytes a run needs: ~40 work arrays, FFT buffers (4x, complex), 4 fields per snapshot, a dense matrix."""
+    from fretsim.solvers import DENSE_SOLVERS
+    need = 8.0 * elements * (40 + 4 * 2 * 4 + 4 * snapshots)
+    if solver in DENSE_SOLVERS:
+        need += 3 * 8.0 * elements**2  # the matrix, its gathered copy, the basis factors
+    return need
 
 
 def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case]:
@@ -121,6 +142,12 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case]:
     notes = []
     sizing = auto_grid(case.geometry, case.dimension, case.radius, case.length, case.normal_load, case.stroke,
                        case.cycles, k_m + k_s, e_star)
+    problems = []
+    if case.stroke > MAX_STROKE_OVER_CONTACT * sizing.hertz_half_width:
+        problems.append(("loading.stroke", f"the stroke amplitude {case.stroke:.4g} mm is "
+                                           f"{case.stroke / sizing.hertz_half_width:.0f} times the Hertz contact "
+                                           f"half-width ({sizing.hertz_half_width:.3g} mm); fretting is a small "
+                                           f"oscillation (up to {MAX_STROKE_OVER_CONTACT:g} a here): check its unit"))
     domain = case.domain
     elements = case.elements
     if domain is None and elements is None:
@@ -136,9 +163,16 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case]:
         notes.append(f"automatic domain for the given elements: {domain}")
     nx = elements[0]
     ny = 1 if plane else elements[1]
+    need = memory_estimate(nx * ny, len(case.snapshots or ()) + 5, case.solver)
+    if need > MEMORY_SHARE * available_memory():
+        problems.append(("grid", f"the grid of {nx} x {ny} elements{' (automatic)' if case.elements is None else ''}"
+                                 f" with solver {case.solver} would need about {need / 2**30:.1f} GiB, more than "
+                                 f"{MEMORY_SHARE:.0%} of this machine's {available_memory() / 2**30:.0f} GiB; "
+                                 f"coarsen the grid, shorten the run, or check the case's units"))
+    if problems:
+        raise CaseError(case.source, problems)
     dy = 1.0 if plane else domain[1] / ny
     grid = Grid.centred(nx, ny, domain[0] / nx, dy, plane_strain=plane)
-    problems = []
     if case.scheme == "adaptive" and case.max_jump is None:
         case = case.with_choices(max_jump=600)  # the paper's ΔN_max
     if case.stroke >= domain[0] / 2:
@@ -196,20 +230,38 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case]:
                   volume_factor=case.length if plane else 1.0,
                   y_edges_free=case.geometry == "cylinder_on_flat", scheme=case.scheme, eta=case.eta,
                   max_jump=case.max_jump, step_tolerance=case.step_tolerance, implicit_cap=cap, coarse=coarse,
-                  coarse_compliance=coarse_op, coarse_gap=coarse_gap, notes=tuple(notes))
+                  coarse_compliance=coarse_op, coarse_gap=coarse_gap, body_radius=case.radius, notes=tuple(notes))
     filled = case.with_choices(domain=tuple(domain[:1] if plane else domain), elements=(nx,) if plane else (nx, ny),
                                linear_jump=jump, snapshots=snapshots)
     return setup, filled
 
 
-def simulate(setup: Setup, observers: tuple = (), progress: Optional[Callable[[int], None]] = None) -> Step:
-    """Run the loop to ``setup.cycles``; returns the last step.  Raises :class:`SimulationError` on failure."""
-    loop = _Loop(setup, observers, progress)
-    return loop.run()
+def simulate(setup: Setup, observers: tuple = (), progress: Optional[Callable[[int], None]] = None,
+             resume: Optional[dict] = None) -> Step:
+    """Run the loop to ``setup.cycles``; returns the last step.  Raises :class:`SimulationError` on failure.
+
+    ``resume`` is a checkpoint (``Step.state`` of an earlier run of the same setup): the loop continues from
+    it and produces the same steps as the uninterrupted run.
+    """
+    return _Loop(setup, observers, progress).run(resume)
+
+
+class PhysicalLimit(SimulationError):
+    """The wear went through the body: the geometry means nothing beyond this cycle."""
+
+    exit_code = 4
+
+
+MAX_RETRIES = 8  # a failed solve is retried with a smaller jump this many times (implicit, adaptive)
 
 
 class _Loop:
-    """The loop's only mutable state: the wear of both bodies, the current pressure, the cycle."""
+    """The loop's only mutable state: wear of both bodies, pressure, cycle, and the stepping scheme's memory.
+
+    All of it is in the attributes listed in ``STATE``, which every emitted step carries as a checkpoint.
+    """
+
+    STATE = ("n", "h_m", "h_s", "p", "p_prev", "d_prev", "jump", "rejected", "batch", "elapsed")
 
     def __init__(self, setup: Setup, observers, progress):
         self.s = setup
@@ -217,10 +269,32 @@ class _Loop:
         self.progress = progress
         self.t0 = time.perf_counter()
         self.reach = (stroke_weights(setup.grid.dx, setup.stroke).size - 1) // 2
+        self.stops = sorted(set(setup.snapshots) | {setup.cycles})
+        self.n, self.d_prev, self.rejected, self.elapsed = 0, 1, 0, 0.0
         self.h_m = np.zeros(setup.grid.shape)
         self.h_s = np.zeros(setup.grid.shape)
-        self.n = 0
-        self.stops = sorted(set(setup.snapshots) | {setup.cycles})
+        self.p = self.p_prev = None
+        self.jump = float(min(setup.linear_jump, setup.implicit_cap))
+        self.batch: list = []
+
+    def state(self) -> dict:
+        st = {k: getattr(self, k) for k in self.STATE}
+        st["elapsed"] = self.elapsed + time.perf_counter() - self.t0
+        st["batch"] = [a for pair in self.batch for a in pair]  # flat list of arrays: m0, s0, m1, s1, ...
+        st["scheme"] = self.s.scheme
+        return st
+
+    def restore(self, st: dict) -> None:
+        if st.get("scheme") != self.s.scheme:
+            raise ValueError(f"the checkpoint is of scheme {st.get('scheme')!r}, the case of {self.s.scheme!r}")
+        for k in self.STATE:
+            if k in st:
+                setattr(self, k, st[k])
+        self.n, self.d_prev, self.rejected = int(self.n), int(self.d_prev), int(self.rejected)
+        self.jump, self.elapsed = float(self.jump), float(self.elapsed)
+        flat = list(st.get("batch", []))
+        self.batch = [(flat[i], flat[i + 1]) for i in range(0, len(flat), 2)]
+        self.t0 = time.perf_counter()
 
     # -- the contact solve, on the fine grid or on the coarse one with refinement (Eqs. 11-12) --
     def contact(self, cycle: int, guess, implicit_cycles: float = 0.0):
@@ -237,7 +311,7 @@ class _Loop:
         if not res.success:
             raise NumericalFailure(f"the contact solve did not converge at cycle {cycle}: {res.message}", self.n)
         if not np.isfinite(res.pressure).all():
-            raise NumericalFailure(f"non-finite pressure at cycle {cycle}", self.n)
+            raise NumericalFailure(f"non-finite pressure from the {s.method} solver at cycle {cycle}", self.n)
         p = res.pressure if s.coarse is None else refine_pressure(res.pressure, s.coarse, s.grid)
         _check_edges(p, self.reach, s.grid, cycle, s)
         return p, res
@@ -251,10 +325,12 @@ class _Loop:
     def next_stop(self) -> int:
         return next(t for t in self.stops if t > self.n)
 
-    def emit(self, p, res, jump: int, rejected: int = 0) -> Step:
+    def emit(self, p, res, jump: int) -> Step:
         s = self.s
-        step = _record(s, self.n, self.h_m, self.h_s, p, res, self.t0)
-        step.jump, step.rejected = jump, rejected
+        self.p = p
+        step = _record(s, self.n, self.h_m, self.h_s, p, res, self.t0 - self.elapsed)
+        step.jump, step.rejected = jump, self.rejected
+        self.rejected = 0
         if step.archard_error > ARCHARD_ROUND_OFF:
             raise NumericalFailure(f"the Archard invariant is broken at cycle {self.n}: wear volume differs from "
                                    f"k·P·4δ·N by {step.archard_error:.2e} (relative)", self.n)
@@ -265,11 +341,30 @@ class _Loop:
                 f"the pressure checkerboards at cycle {self.n}: {what} for this grid (explicit stability limit "
                 f"{s.stability_limit:.4g} cycles); reduce jumping.linear (or jumping.max), leave them out for the "
                 f"automatic choice, or use jumping.scheme: implicit", self.n)
+        step.state = self.state()
         for obs in self.observers:
             obs.on_step(s, step)
         if self.progress is not None and jump:
             self.progress(jump)
+        self._check_body(p)
         return step
+
+    def _check_body(self, p) -> None:
+        """Stop where the geometry stops meaning anything: worn through, or a scar past half the radius, where
+        the paraboloid gap of Eqs. 9-10 departs from the circle by more than 7 %."""
+        s = self.s
+        if not s.body_radius:
+            return
+        depth = float(self.h_m.max())
+        X, Y = s.grid.mesh()
+        reach = float(np.sqrt(X**2 + (0 if s.y_edges_free else Y**2))[p > 0].max()) + s.grid.dx / 2
+        if depth >= s.body_radius:
+            raise PhysicalLimit(f"the moving body's wear depth {depth:.4g} mm reached its radius "
+                                f"{s.body_radius:.4g} mm at cycle {self.n}: the body is worn through", self.n)
+        if reach >= s.body_radius / 2:
+            raise PhysicalLimit(f"the contact reached {reach:.4g} mm from the centre at cycle {self.n}, half the "
+                                f"radius {s.body_radius:.4g} mm (wear depth {depth * 1e3:.4g} µm): beyond it the "
+                                f"body's worn shape is no longer the paraboloid this model assumes", self.n)
 
     def advance(self, dh_m, dh_s, d_n: int) -> None:
         if (dh_m < 0).any() or (dh_s < 0).any():
@@ -278,52 +373,59 @@ class _Loop:
         self.h_s = self.h_s + dh_s
         self.n += d_n
 
-    def run(self) -> Step:
+    def run(self, resume: Optional[dict] = None) -> Step:
         s = self.s
-        p, res = self.contact(0, None)
-        try:
-            check_resolution(res, (s.coarse or s.grid).plane_strain)
-        except ValueError as exc:
-            raise CaseError("grid", [("grid.elements", str(exc))]) from None
-        step = self.emit(p, res, 0)
-        if s.cycles == 0:
+        step = None
+        if resume is None:
+            p, res = self.contact(0, None)
+            try:
+                check_resolution(res, (s.coarse or s.grid).plane_strain)
+            except ValueError as exc:
+                raise CaseError("grid", [("grid.elements", str(exc))]) from None
+            step = self.emit(p, res, 0)
+        else:
+            self.restore(resume)
+        if s.cycles == 0 or self.n >= s.cycles:
             return step
-        return {"linear": self._linear, "adaptive": self._adaptive, "implicit": self._implicit}[s.scheme](p, step)
+        return {"linear": self._linear, "adaptive": self._adaptive, "implicit": self._implicit}[s.scheme]() or step
 
-    def _explicit_step(self, p, p_prev, d_prev, d_n):
-        r_m, r_s = self.rates(p)
+    def _explicit_step(self, d_n):
+        r_m, r_s = self.rates(self.p)
         self.advance(r_m * d_n, r_s * d_n, d_n)
         # predictor: extrapolate the pressure history so the warm start begins closer to the answer
-        guess = p if p_prev is None else np.clip(p + (p - p_prev) * (d_n / d_prev), 0.0, None)
-        return self.contact(self.n, guess)
+        p = self.p
+        guess = p if self.p_prev is None else np.clip(p + (p - self.p_prev) * (d_n / self.d_prev), 0.0, None)
+        p_new, res = self.contact(self.n, guess)
+        self.p_prev, self.d_prev = p, d_n
+        return p_new, res
 
-    def _linear(self, p, step) -> Step:
-        p_prev, d_prev = None, 1
+    def _linear(self) -> Step:
+        step = None
         while self.n < self.s.cycles:
             d_n = min(self.s.linear_jump, self.next_stop() - self.n)
-            p_new, res = self._explicit_step(p, p_prev, d_prev, d_n)
-            p_prev, d_prev, p = p, d_n, p_new
+            p, res = self._explicit_step(d_n)
             step = self.emit(p, res, d_n)
         return step
 
-    def _adaptive(self, p, step) -> Step:
+    def _adaptive(self) -> Step:
         """Batches of Q_LINEAR linear steps, then a Taylor jump (paper Eqs. 19-21, Fig. 8), under control.
 
         The jump extrapolates with the current wear rates, so past the explicit stability limit it excites the
         odd-even pressure mode like a too-long linear step (measured: depth still within 1 %, pressure 14-26 %
-        off).  A jump after which the pressure checkerboards is therefore undone and retried at half the
-        length (counted in ``rejected``); below the linear jump it becomes a linear step.  Jumps never end on
-        a snapshot or the last cycle: those are reached by linear steps, so recorded states are stabilised.
+        off).  A jump after which the pressure checkerboards, or whose solve fails, is undone and retried at
+        half the length (counted as rejected); below the linear jump it becomes a linear step.  Jumps never
+        end on a snapshot or the last cycle: those are reached by linear steps, so recorded states are
+        stabilised.
         """
         s = self.s
         lin = s.linear_jump
-        batch = [(self.h_m, self.h_s)]
-        p_prev, d_prev = None, 1
-        rejected = 0
+        step = None
+        if not self.batch:
+            self.batch = [(self.h_m, self.h_s)]
         while self.n < s.cycles:
             room = self.next_stop() - self.n
-            if len(batch) > Q_LINEAR and room > (Q_LINEAR + 1) * lin:
-                (m2, s2), (m1, s1), (m0, s0) = batch[-3:]
+            if len(self.batch) > Q_LINEAR and room > (Q_LINEAR + 1) * lin:
+                (m2, s2), (m1, s1), (m0, s0) = self.batch[-3:]
                 jump = min(taylor_jump([(m2, m1, m0), (s2, s1, s0)], lin, s.eta, s.max_jump or 600),
                            room - Q_LINEAR * lin)
                 while jump > lin:
@@ -334,46 +436,57 @@ class _Loop:
                         continue
                     saved = (self.h_m, self.h_s, self.n)
                     self.advance(new_m - m0, new_s - s0, jump)
-                    p_jump, res = self.contact(self.n, p)
-                    if checkerboard_amplitude(res.pressure) > JUMP_ACCEPT * CHECKERBOARD_LIMIT:
+                    try:
+                        p_jump, res = self.contact(self.n, self.p)
+                        unstable = checkerboard_amplitude(res.pressure) > JUMP_ACCEPT * CHECKERBOARD_LIMIT
+                    except NumericalFailure:
+                        unstable = True
+                    if unstable:
                         self.h_m, self.h_s, self.n = saved
-                        rejected += 1
+                        self.rejected += 1
                         jump //= 2
                         continue
-                    p, p_prev = p_jump, None
-                    step = self.emit(p, res, jump, rejected)
-                    rejected = 0
+                    self.p_prev = None
+                    self.batch = [(self.h_m, self.h_s)]
+                    step = self.emit(p_jump, res, jump)
                     break
-                batch = [(self.h_m, self.h_s)]
+                else:
+                    self.batch = [(self.h_m, self.h_s)]
                 if jump > lin:
                     continue
             d_n = min(lin, room)
-            p_new, res = self._explicit_step(p, p_prev, d_prev, d_n)
-            p_prev, d_prev, p = p, d_n, p_new
-            step = self.emit(p, res, d_n, rejected)
-            rejected = 0
+            p, res = self._explicit_step(d_n)
             # a shortened step breaks the equal spacing the differences need: restart the batch
-            batch = batch + [(self.h_m, self.h_s)] if d_n == lin else [(self.h_m, self.h_s)]
+            self.batch = self.batch + [(self.h_m, self.h_s)] if d_n == lin else [(self.h_m, self.h_s)]
+            step = self.emit(p, res, d_n)
         return step
 
-    def _implicit(self, p, step) -> Step:
+    def _implicit(self) -> Step:
         """Backward-Euler wear steps, each a contact solve with C + ΔN·4δ·(k_m I + k_s B), under error control.
 
         The local error of a backward-Euler step is about (ΔN/2)·(r_{n+1} − r_n) (r the wear rate per cycle);
         its root-mean-square over the grid, relative to that of the body's depth after the step, must stay
         below the tolerance, else the step is redone smaller.  (A maximum norm would be ruled by the few
         elements entering contact at the scar's edge, whose share of the depth error is small.)  Accepted
-        steps grow geometrically while the scar settles.
+        steps grow geometrically while the scar settles.  A solve that fails is retried with a quarter step.
         """
         s = self.s
-        r_old = self.rates(p)
-        jump = float(min(s.linear_jump, s.implicit_cap))
-        rejected = 0
-        p_prev, d_prev = None, 1
+        step = None
+        r_old = self.rates(self.p)
+        retries = 0
         while self.n < s.cycles:
-            d_n = int(max(1, min(jump, self.next_stop() - self.n, s.implicit_cap, s.max_jump or np.inf)))
-            guess = p if p_prev is None else np.clip(p + (p - p_prev) * (d_n / d_prev), 0.0, None)
-            p_new, res = self.contact(self.n + d_n, guess, implicit_cycles=d_n)
+            d_n = int(max(1, min(self.jump, self.next_stop() - self.n, s.implicit_cap, s.max_jump or np.inf)))
+            p = self.p
+            guess = p if self.p_prev is None else np.clip(p + (p - self.p_prev) * (d_n / self.d_prev), 0.0, None)
+            try:
+                p_new, res = self.contact(self.n + d_n, guess, implicit_cycles=d_n)
+            except NumericalFailure:
+                if d_n == 1 or retries >= MAX_RETRIES:
+                    raise
+                retries += 1
+                self.rejected += 1
+                self.jump = max(1.0, d_n / 4)
+                continue
             r_new = self.rates(p_new)
             error = 0.0
             for (old, new), h in zip(zip(r_old, r_new), (self.h_m, self.h_s)):
@@ -381,15 +494,15 @@ class _Loop:
                 if depth > 0:
                     error = max(error, 0.5 * d_n * float(np.linalg.norm(new - old)) / depth)
             if error > 1.5 * s.step_tolerance and d_n > 1:
-                rejected += 1
-                jump = next_implicit_jump(d_n, error, s.step_tolerance)
+                self.rejected += 1
+                self.jump = next_implicit_jump(d_n, error, s.step_tolerance)
                 continue
+            retries = 0
             self.advance(r_new[0] * d_n, r_new[1] * d_n, d_n)
-            p_prev, d_prev = p, d_n
-            p, r_old = p_new, r_new
-            step = self.emit(p, res, d_n, rejected)
-            rejected = 0
-            jump = next_implicit_jump(d_n, error, s.step_tolerance)
+            self.p_prev, self.d_prev = p, d_n
+            r_old = r_new
+            self.jump = next_implicit_jump(d_n, error, s.step_tolerance)
+            step = self.emit(p_new, res, d_n)
         return step
 
 

@@ -43,6 +43,8 @@ def auto_grid(geometry: str, dimension: str, radius: float, length: float | None
     else:
         a = hertz_point(load, radius, e_star).radius
         scar = (4 * radius * k_total * load * 4 * stroke * cycles / math.pi) ** 0.25
+    # no contact is wider than the body: beyond that the run stops at the physical limit (worn through)
+    scar = min(scar, radius)
     dx = 7 * a / ELEMENTS_OVER_7A
     reach = SCAR_MARGIN * max(scar, a) + stroke + 3 * dx
     nx = _odd(2 * reach / dx)

@@ -14,7 +14,7 @@ import re
 
 # dimension -> {unit spelling: factor to the internal unit}
 UNITS: dict[str, dict[str, float]] = {
-    "length": {"m": 1e3, "mm": 1.0, "um": 1e-3, "µm": 1e-3, "micron": 1e-3, "nm": 1e-6, "cm": 10.0},
+    "length": {"km": 1e6, "m": 1e3, "mm": 1.0, "um": 1e-3, "µm": 1e-3, "micron": 1e-3, "nm": 1e-6, "cm": 10.0},
     "force": {"N": 1.0, "kN": 1e3, "mN": 1e-3},
     "pressure": {"Pa": 1e-6, "kPa": 1e-3, "MPa": 1.0, "GPa": 1e3, "N/mm2": 1.0, "N/mm^2": 1.0},
     "wear_coefficient": {"1/MPa": 1.0, "1/Pa": 1e6, "1/GPa": 1e-3, "mm2/N": 1.0, "mm^2/N": 1.0, "m2/N": 1e6,
@@ -35,7 +35,8 @@ def parse_quantity(value: object, dimension: str) -> float:
     Raises :class:`UnitError` with a message that says what was expected.
     """
     table = UNITS[dimension]
-    expected = f"a number with a {dimension.replace('_', ' ')} unit ({', '.join(list(table)[:5])}), e.g. '{_example(dimension)}'"
+    shown = [u for u in table if u != "km"][:5]
+    expected = f"a number with a {dimension.replace('_', ' ')} unit ({', '.join(shown)}), e.g. '{_example(dimension)}'"
     if isinstance(value, bool) or value is None:
         raise UnitError(f"got {value!r}; expected {expected}")
     if isinstance(value, (int, float)):
@@ -62,4 +63,4 @@ def _example(dimension: str) -> str:
 
 def format_quantity(value: float, dimension: str) -> str:
     """Inverse of :func:`parse_quantity` in the internal unit (used to write the filled case)."""
-    return f"{value:.12g} {INTERNAL[dimension]}"
+    return f"{value!r} {INTERNAL[dimension]}"  # repr round-trips exactly: a resumed run rebuilds the same grid

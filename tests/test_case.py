@@ -64,8 +64,13 @@ def test_negative_load_is_rejected():
 
 def test_stroke_larger_than_the_domain_is_rejected():
     probs, _ = problems_of(CONTRACT.replace("grid:      {}", "grid: {domain: [0.5 mm, 10 mm], elements: [81, 27]}")
-                           .replace("25 um", "25 mm"))
+                           .replace("25 um", "300 um"))
     assert "larger than half the grid" in probs["loading.stroke"]
+
+
+def test_absurd_magnitudes_are_caught_with_their_unit_named():
+    probs, _ = problems_of(CONTRACT, overrides=["geometry.radius=1 km", "loading.stroke=25 mm"])
+    assert "plausible range" in probs["geometry.radius"] and "plausible range" in probs["loading.stroke"]
 
 
 def test_all_problems_are_reported_together():
