@@ -200,15 +200,17 @@ class _Reader:
     def fail(self, path: str, msg: str) -> None:
         self.problems.append((path, msg))
 
-    def section(self, raw: dict, name: str, keys: set, required: bool = True) -> dict:
+    def section(self, raw: dict, name: str, keys: set, required: bool = True) -> Optional[dict]:
+        """The section's mapping ({} if optional and absent); None, with the problem recorded, if unusable."""
         value = raw.get(name)
         if value is None:
             if required:
                 self.fail(name, f"missing section; expected a mapping with keys {', '.join(sorted(keys))}")
+                return None
             return {}
         if not isinstance(value, dict):
             self.fail(name, f"expected a mapping with keys {', '.join(sorted(keys))}, got a {type(value).__name__}")
-            return {}
+            return None if required else {}
         self.unknown(value, keys, name)
         return value
 
@@ -291,8 +293,8 @@ def _validate(raw: dict, problems: list, source: str, default_name: str) -> Opti
     name = str(name)
 
     geo = r.section(raw, "geometry", SECTIONS["geometry"])
-    gtype = r.choice(geo, "type", "geometry.type", GEOMETRIES) if geo else None
-    radius = r.quantity(geo, "radius", "geometry", "length", plausible=LENGTH_RANGE) if geo else None
+    gtype = r.choice(geo, "type", "geometry.type", GEOMETRIES) if geo is not None else None
+    radius = r.quantity(geo, "radius", "geometry", "length", plausible=LENGTH_RANGE) if geo is not None else None
     length = None
     if gtype == "cylinder_on_flat":
         length = r.quantity(geo, "length", "geometry", "length", plausible=LENGTH_RANGE)
@@ -302,7 +304,7 @@ def _validate(raw: dict, problems: list, source: str, default_name: str) -> Opti
     mats = r.section(raw, "materials", SECTIONS["materials"])
     materials = {}
     for body in ("moving", "stationary"):
-        if not mats:
+        if mats is None:
             break
         m = mats.get(body)
         path = f"materials.{body}"
@@ -326,11 +328,11 @@ def _validate(raw: dict, problems: list, source: str, default_name: str) -> Opti
 
     load = r.section(raw, "loading", SECTIONS["loading"])
     normal_load = r.quantity(load, "normal_load", "loading", "force", plausible=(1e-6, 1e7, "1 µN to 10 MN")) \
-        if load else None
+        if load is not None else None
     stroke = r.quantity(load, "stroke", "loading", "length", plausible=(1e-6, 10.0, "1 nm to 10 mm")) \
-        if load else None
+        if load is not None else None
     cycles = None
-    if load:
+    if load is not None:
         if "cycles" not in load:
             r.fail("loading.cycles", "missing; expected a whole number of cycles (0 solves the contact alone)")
         else:

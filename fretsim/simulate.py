@@ -30,6 +30,7 @@ from fretsim.solvers import check_resolution, solve
 from fretsim.wear import archard_depth, archard_volume, stroke_average, stroke_weights
 
 ARCHARD_ROUND_OFF = 1e-9
+LOAD_BALANCE = 1e-8  # every solver enforces Σp·A = P exactly; a larger error is a solver fault
 MAX_STROKE_OVER_CONTACT = 50.0  # δ/a beyond this is sliding, not fretting, or a unit slip (µm → mm)
 MEMORY_SHARE = 0.5  # refuse a grid that would take more than this share of the machine's memory
 # A Taylor jump is accepted only if it leaves the odd-even pressure amplitude below half the failure threshold:
@@ -312,6 +313,12 @@ class _Loop:
             raise NumericalFailure(f"the contact solve did not converge at cycle {cycle}: {res.message}", self.n)
         if not np.isfinite(res.pressure).all():
             raise NumericalFailure(f"non-finite pressure from the {s.method} solver at cycle {cycle}", self.n)
+        if (res.pressure < 0).any():
+            raise NumericalFailure(f"negative pressure from the {s.method} solver at cycle {cycle}", self.n)
+        imbalance = float(res.pressure.sum()) * op.grid.area / s.load - 1.0
+        if abs(imbalance) > LOAD_BALANCE:
+            raise NumericalFailure(f"the {s.method} solution at cycle {cycle} violates the load balance by "
+                                   f"{imbalance:.1e} (relative): the Archard invariant would break", self.n)
         p = res.pressure if s.coarse is None else refine_pressure(res.pressure, s.coarse, s.grid)
         _check_edges(p, self.reach, s.grid, cycle, s)
         return p, res
