@@ -268,6 +268,21 @@ class _Reader:
             return None
         return int(value)
 
+    def vector(self, mapping: dict, key: str, want: int, item, expected: str) -> Optional[tuple]:
+        """A list of one (2d) or two (3d) items, each read by ``item(value, path)``; None if absent or bad."""
+        path = f"grid.{key}"
+        value = mapping.get(key) if mapping else None
+        if value is None:
+            return None
+        if not isinstance(value, list) or not 1 <= len(value) <= 2:
+            self.fail(path, f"expected a list {expected}")
+            return None
+        vals = [item(v, f"{path}[{i}]") for i, v in enumerate(value)]
+        if len(value) < want:
+            self.fail(path, f"a 3d case needs two entries: {expected}")
+            return None
+        return None if None in vals else tuple(vals[:want])
+
     def choice(self, mapping: dict, key: str, path: str, options: tuple, default: Optional[str] = None):
         v = mapping.get(key, default)
         if v is None:
@@ -365,40 +380,18 @@ def _validate(raw: dict, problems: list, source: str, default_name: str) -> Opti
     step_tolerance = r.number(jumping, "tolerance", "jumping.tolerance", 1e-8, 0.5, required=False, default=1e-2)
 
     grid = r.section(raw, "grid", SECTIONS["grid"], required=False)
-    domain = elements = None
     want = 1 if dimension == "2d" else 2
-    if "domain" in grid:
-        d = grid["domain"]
-        if not isinstance(d, list) or not 1 <= len(d) <= 2:
-            r.fail("grid.domain", "expected a list [x extent, y extent] of lengths, e.g. [1 mm, 10 mm]")
-        else:
-            vals = [r.quantity({"v": v}, "v", f"grid.domain[{i}]", "length") for i, v in enumerate(d)]
-            if len(d) < want:
-                r.fail("grid.domain", "a 3d case needs two extents [x, y]")
-            elif None not in vals:
-                domain = tuple(vals[:want])
-    if "elements" in grid:
-        e = grid["elements"]
-        if not isinstance(e, list) or not 1 <= len(e) <= 2:
-            r.fail("grid.elements", "expected a list [Mx, My] of whole numbers, e.g. [101, 27]")
-        else:
-            vals = [r.integer(v, f"grid.elements[{i}]", 1, 100_000) for i, v in enumerate(e)]
-            if len(e) < want:
-                r.fail("grid.elements", "a 3d case needs two counts [Mx, My]")
-            elif None not in vals:
-                elements = tuple(vals[:want])
 
-    coarse = None
-    if grid.get("coarse_element") is not None:
-        ce = grid["coarse_element"]
-        if not isinstance(ce, list) or not 1 <= len(ce) <= 2:
-            r.fail("grid.coarse_element", "expected a list [dx, dy] of lengths, e.g. [15.75 um, 1000 um]")
-        else:
-            vals = [r.quantity({"v": v}, "v", f"grid.coarse_element[{i}]", "length") for i, v in enumerate(ce)]
-            if len(ce) < want:
-                r.fail("grid.coarse_element", "a 3d case needs two sizes [dx, dy]")
-            elif None not in vals:
-                coarse = tuple(vals[:want])
+    def length_item(v, path):
+        return r.quantity({"v": v}, "v", path, "length")
+
+    def count_item(v, path):
+        return r.integer(v, path, 1, 100_000)
+
+    domain = r.vector(grid, "domain", want, length_item, "[x extent, y extent] of lengths, e.g. [1 mm, 10 mm]")
+    elements = r.vector(grid, "elements", want, count_item, "[Mx, My] of whole numbers, e.g. [101, 27]")
+    coarse = r.vector(grid, "coarse_element", want, length_item,
+                      "[dx, dy] of lengths, e.g. [15.75 um, 1000 um]")
 
     output = r.section(raw, "output", SECTIONS["output"], required=False)
     snaps = output.get("snapshots", "auto")

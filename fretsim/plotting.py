@@ -37,36 +37,37 @@ def _title(res: Results, what: str) -> str:
 
 
 def _profiles(res: Results, path: Path) -> Path:
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharex=True)
-    cycles = res.fields["cycle"]
-    for ax, body in zip(axes, ("moving", "stationary")):
-        data = res.fields[f"wear_depth_{body}"]
-        for k, n in enumerate(cycles):
-            ax.plot(res.x, -centre_line(data[k]), label=f"N = {n}")
-        ax.set_xlabel("x, sliding direction (mm)")
-        ax.set_ylabel(f"worn profile, -depth ({res.units['fields/wear_depth_' + body]})".replace("um", "µm"))
-        ax.set_title(f"{body} body, centre line y = 0")
-        ax.grid(alpha=0.3)
-    axes[1].legend(fontsize=8)
-    fig.suptitle(_title(res, "wear profiles"))
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return _centre_line_pair(res, path, "wear profiles", [
+        ("wear_depth_moving", "moving body, centre line y = 0", "worn profile, -depth"),
+        ("wear_depth_stationary", "stationary body, centre line y = 0", "worn profile, -depth")], sign=-1.0)
 
 
 def _pressure(res: Results, path: Path) -> Path:
+    return _centre_line_pair(res, path, "pressure profiles", [
+        ("pressure", "moving body (mid-stroke), y = 0", "contact pressure"),
+        ("pressure_stationary_average", "stationary body (stroke average), y = 0", "contact pressure")])
+
+
+def _centre_line_pair(res: Results, path: Path, what: str, panels, sign: float = 1.0) -> Path:
+    """Two panels of a field along the centre line at every snapshot."""
     fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharex=True)
-    for ax, (name, label) in zip(axes, (("pressure", "moving body (mid-stroke)"),
-                                        ("pressure_stationary_average", "stationary body (stroke average)"))):
+    for ax, (name, title, quantity) in zip(axes, panels):
         for k, n in enumerate(res.fields["cycle"]):
-            ax.plot(res.x, centre_line(res.fields[name][k]), label=f"N = {n}")
+            ax.plot(res.x, sign * centre_line(res.fields[name][k]), label=f"N = {n}")
         ax.set_xlabel("x, sliding direction (mm)")
-        ax.set_ylabel(f"contact pressure ({res.units['fields/' + name]})")
-        ax.set_title(label + ", y = 0")
+        ax.set_ylabel(f"{quantity} ({_unit(res, 'fields/' + name)})")
+        ax.set_title(title)
         ax.grid(alpha=0.3)
-    axes[0].legend(fontsize=8)
-    fig.suptitle(_title(res, "pressure profiles"))
+    axes[1].legend(fontsize=8)
+    return _save(fig, res, what, path)
+
+
+def _unit(res: Results, key: str) -> str:
+    return res.units[key].replace("um", "µm")
+
+
+def _save(fig, res: Results, what: str, path: Path) -> Path:
+    fig.suptitle(_title(res, what))
     fig.tight_layout()
     fig.savefig(path, dpi=120)
     plt.close(fig)
@@ -80,14 +81,10 @@ def _history(res: Results, path: Path) -> Path:
                         ("max_wear_depth_moving", "moving")):
         ax.plot(h["cycle"], h[name], label=label, marker="." if h["cycle"].size < 60 else None)
     ax.set_xlabel("cycles (–)")
-    ax.set_ylabel(f"maximum wear depth ({res.units['history/max_wear_depth_total']})".replace("um", "µm"))
+    ax.set_ylabel(f"maximum wear depth ({_unit(res, 'history/max_wear_depth_total')})")
     ax.grid(alpha=0.3)
     ax.legend()
-    ax.set_title(_title(res, "maximum wear depth"))
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return _save(fig, res, "maximum wear depth", path)
 
 
 def _maps(res: Results, path: Path) -> Path:
@@ -99,8 +96,4 @@ def _maps(res: Results, path: Path) -> Path:
         ax.set_xlabel("x, sliding direction (mm)")
         ax.set_ylabel("y (mm)")
         ax.set_title(f"{body} body at N = {res.fields['cycle'][-1]}")
-    fig.suptitle(_title(res, "wear maps"))
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+    return _save(fig, res, "wear maps", path)
