@@ -113,7 +113,3 @@ class Compliance:
         # C[(jy,ix),(ky,kx)] = K[jy-ky+ny-1, ix-kx+nx-1]: windows of the flipped kernel, one strided copy
         windows = np.lib.stride_tricks.sliding_window_view(self.kernel[::-1, ::-1], (ny, nx))
         return np.ascontiguousarray(windows[::-1, ::-1]).reshape(n, n)
-
-    def symbol(self) -> np.ndarray:
-        """Real Fourier symbol of C on the padded grid (rfft2 layout): its eigenvalues for periodic modes."""
-        return self._kernel_hat.real

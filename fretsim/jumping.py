@@ -76,18 +76,6 @@ def default_linear_jump(limit: float, cycles: int) -> int:
     return int(max(1, min(cycles if cycles > 0 else 1, np.floor(SAFETY * limit))))
 
 
-def linear_schedule(cycles: int, jump: int, stops: tuple[int, ...] = ()) -> list[int]:
-    """Step sizes of at most ``jump`` cycles that land exactly on every stop and on ``cycles``."""
-    targets = sorted({s for s in stops if 0 < s < cycles} | {cycles}) if cycles > 0 else []
-    steps, n = [], 0
-    for target in targets:
-        while n < target:
-            d = min(jump, target - n)
-            steps.append(d)
-            n += d
-    return steps
-
-
 CHECKERBOARD_LIMIT = 0.01  # odd-even amplitude relative to the mean interior pressure
 
 

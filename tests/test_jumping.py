@@ -6,17 +6,7 @@ from conftest import E_STAR
 from fretsim.compliance import Compliance
 from fretsim.grid import Grid
 from fretsim.jumping import (checkerboard_amplitude, compliance_symbol_x, default_linear_jump,
-                             explicit_stability_limit, is_checkerboard, linear_schedule)
-
-
-def test_schedule_lands_on_every_stop_and_the_end():
-    steps = linear_schedule(1000, 55, (100, 500))
-    ends = np.cumsum(steps)
-    assert ends[-1] == 1000 and 100 in ends and 500 in ends and max(steps) <= 55
-
-
-def test_schedule_of_zero_cycles_is_empty():
-    assert linear_schedule(0, 10) == []
+                             explicit_stability_limit, is_checkerboard)
 
 
 def _min_eigenvalue_zero_sum(dense):
