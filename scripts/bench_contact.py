@@ -129,7 +129,7 @@ def race(label, grid, gap, load, reference, metric, msm_limit, peers, repeats, r
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="small grids only (a smoke run)")
-    ap.add_argument("--out", default="scripts/out")
+    ap.add_argument("--out", default=str(Path(__file__).resolve().parent / "out"))
     args = ap.parse_args()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)

@@ -44,7 +44,7 @@ def combos(quick: bool):
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="185 N only, 2000 cycles, few combinations")
-    ap.add_argument("--out", default="scripts/out")
+    ap.add_argument("--out", default=str(Path(__file__).resolve().parent / "out"))
     args = ap.parse_args()
     out = Path(args.out)
     rows = []

@@ -28,7 +28,7 @@ LEVELS = {"eta": (0.1, 0.55, 1.0), "max": (100, 345, 600), "linear": (10, 55, 10
 
 def main():
     ap = argparse.ArgumentParser()
-    ap.add_argument("--out", default="scripts/out")
+    ap.add_argument("--out", default=str(Path(__file__).resolve().parent / "out"))
     args = ap.parse_args()
     out = Path(args.out)
     ref = run_case(BASE, [*COMMON, "jumping.scheme=linear", "jumping.linear=1"])

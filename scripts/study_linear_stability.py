@@ -31,7 +31,7 @@ UNSTABLE_MAPE = 5.0  # % : where the error leaves the smooth O(ΔN) trend
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="case 1 only, fewer jumps, 2000 cycles")
-    ap.add_argument("--out", default="scripts/out")
+    ap.add_argument("--out", default=str(Path(__file__).resolve().parent / "out"))
     args = ap.parse_args()
     out = Path(args.out)
     cases = dict(list(TABLE1.items())[:1]) if args.quick else TABLE1
