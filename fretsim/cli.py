@@ -104,9 +104,14 @@ def _paragraph(outcome) -> str:
     s, c, g = outcome.summary, outcome.case, outcome.setup.grid
     cells = f"{g.shape[1]} elements" if g.plane_strain else f"{g.shape[1]} × {g.shape[0]} elements"
     size = f"{g.dx * 1e3:.3g} µm" if g.plane_strain else f"{g.dx * 1e3:.3g} × {g.dy * 1e3:.3g} µm"
-    text = (f"{c.name}: {s['cycles']} cycles, {c.dimension.upper()} {c.geometry}, {cells} of {size}, solver "
-            f"{c.solver}, linear jump {s['linear_jump']} cycles (stability limit {s['stability_limit_linear']:.3g}); "
-            f"{s['contact_solves']} contact solves in {s['wall_time_s']:.2f} s.")
+    stepping = {
+        "implicit": f"implicit steps (tolerance {c.step_tolerance:g})",
+        "linear": f"linear jump {s['linear_jump']} cycles (stability limit {s['stability_limit_linear']:.3g})",
+        "adaptive": f"adaptive jumps (η {c.eta:g}, ΔN_max {c.max_jump}, ΔN_L {s['linear_jump']})",
+    }[c.scheme]
+    refined = f", contact on a {c.coarse_element[0] * 1e3:.3g} µm coarse grid" if c.coarse_element else ""
+    text = (f"{c.name}: {s['cycles']} cycles, {c.dimension.upper()} {c.geometry}, {cells} of {size}{refined}, solver "
+            f"{c.solver}, {stepping}; {s['contact_solves']} contact solves in {s['wall_time_s']:.2f} s.")
     if s["cycles"] > 0:
         text += (f" Stationary body: centre-line wear depth {s['centre_wear_depth_stationary_um']:.3g} µm "
                  f"(max {s['max_wear_depth_stationary_um']:.3g} µm), scar width {s['scar_width_stationary_mm']:.3g} mm,"

@@ -11,7 +11,8 @@
 Crash safety: the writer keeps the run in memory and, at every flush, writes the whole file to a temporary
 file beside it and renames it over the results file (an atomic replacement on POSIX).  The file on disk is
 therefore always a complete, valid HDF5 file — after Ctrl-C, SIGTERM or kill -9 alike — holding every step
-up to the last flush (at most FLUSH_SECONDS old) together with the state to resume from.
+up to the last flush (at most FLUSH_SECONDS old) together with the state to resume from.  Flushes happen
+at the first step, then at most every FLUSH_SECONDS, and at the end.
 """
 from __future__ import annotations
 
@@ -95,7 +96,9 @@ class ResultsWriter:
             for name, (_, get) in FIELDS.items():
                 self.fields[name].append(np.array(get(step)))
         self.state = step.state
-        if step.is_snapshot or len(self.rows) == 1 or time.monotonic() - self._flushed > FLUSH_SECONDS:
+        # the first step (so the file exists at once), then at most every FLUSH_SECONDS: each flush rewrites the
+        # whole file, and a kill costs at most the steps since the last one, which --resume recomputes
+        if len(self.rows) == 1 or time.monotonic() - self._flushed > FLUSH_SECONDS:
             self.flush()
 
     def finish(self, status: str, message: str = "", summary: Optional[dict] = None) -> None:
