@@ -39,19 +39,23 @@ def coarsen(field: np.ndarray, fine: Grid, coarse: Grid) -> np.ndarray:
 
 
 def _redistribute(forces: np.ndarray, src: np.ndarray, dst: np.ndarray) -> np.ndarray:
-    """Share each row's total over the dst positions with Akima-interpolated weights (rows: axis 0)."""
+    """Share each row's total over the dst positions with Akima-interpolated weights (rows: axis 0).
+
+    All rows are interpolated in one vector-valued spline; rows carrying no force stay zero.
+    """
+    totals = forces.sum(axis=1)
+    loaded = totals > 0
     out = np.zeros((forces.shape[0], dst.size))
-    for j, row in enumerate(forces):
-        total = row.sum()
-        if total <= 0:
-            continue
-        weights = row * row.size / total  # Eq. 11: weights average 1 over the row
-        if row.size < 3:
-            fine = np.interp(dst, src, weights)
-        else:
-            fine = Akima1DInterpolator(src, weights, extrapolate=True)(dst)
-        fine = np.clip(np.nan_to_num(fine), 0.0, None)
-        out[j] = fine * (total / fine.sum()) if fine.sum() > 0 else 0.0  # Eq. 12: the row keeps its total
+    if not loaded.any():
+        return out
+    weights = forces[loaded] * (forces.shape[1] / totals[loaded, None])  # Eq. 11: weights average 1 per row
+    if src.size < 3:
+        fine = np.array([np.interp(dst, src, w) for w in weights])
+    else:
+        fine = Akima1DInterpolator(src, weights, axis=1, extrapolate=True)(dst)
+    fine = np.clip(np.nan_to_num(fine), 0.0, None)
+    sums = fine.sum(axis=1, keepdims=True)
+    out[loaded] = np.where(sums > 0, fine * (totals[loaded, None] / np.where(sums > 0, sums, 1.0)), 0.0)  # Eq. 12
     return out
 
 
