@@ -1,8 +1,10 @@
 """A YAML case → one validated, frozen :class:`Case` (all problems reported together, each with its YAML path).
 
 The layout is a contract users write against (see README): sections ``name``, ``geometry``, ``materials``,
-``loading``, ``model``, ``solver``, ``jumping``, ``grid``, ``output``.  Every dimensional value carries its
-unit; values are stored in the internal mm–N–MPa system (see :mod:`fretsim.units`).
+``loading``, ``model``, ``solver``, ``jumping``, ``grid``, ``output`` and ``expected`` (published values kept
+beside the inputs, never run).  Every key is declared once in :data:`SCHEMA` — its kind, unit, default,
+range and meaning — and read from there; ``fretsim case-reference`` prints the same table, so the reference
+cannot drift from the parser.  Values are stored in the internal mm–N–MPa system (see :mod:`fretsim.units`).
 """
 from __future__ import annotations
 
@@ -12,41 +14,121 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Optional
 
-import yaml
-
+from fretsim.geometry import GEOMETRIES, BallOnFlat, CrossedCylinders, CylinderOnFlat, Geometry
 from fretsim.units import UnitError, format_quantity, parse_quantity
+from fretsim.yamlread import YamlProblem, excerpt, loads, read_text
 
-GEOMETRIES = ("cylinder_on_flat", "ball_on_flat")
-SCHEMES = ("implicit", "linear", "adaptive")
+SCHEMES = ("bdf2", "implicit", "linear", "adaptive")
 # the paper's DOE optimum (section 3.1): η = 0.55, ΔN_max = 600, ΔN_L = 55
 PRESETS = {"paper": {"scheme": "adaptive", "eta": 0.55, "max": 600, "linear": 55}}
-DIMENSIONS = ("2d", "3d")
-SECTIONS = {
-    "name": None,
-    "geometry": {"type", "radius", "length"},
-    "materials": {"moving", "stationary"},
-    "loading": {"normal_load", "stroke", "cycles"},
-    "model": {"dimension"},
-    "solver": {"method", "tolerance"},
-    "jumping": {"scheme", "linear", "eta", "max", "tolerance", "preset"},
-    "grid": {"domain", "elements", "coarse_element"},
-    "output": {"snapshots"},
-}
-MATERIAL_KEYS = {"youngs_modulus", "poissons_ratio", "wear_coefficient"}
+DIMENSIONS = ("2d", "3d", "auto")
+GAP_MODELS = ("auto", "mid_stroke", "stroke_average")
+CORRECTIONS = ("finite_space", "ring_bending")
 MAX_CYCLES = 10**10
 LENGTH_RANGE = (1e-3, 1e4, "1 µm to 10 m")
+REQUIRED = object()
+
+
+@dataclass(frozen=True)
+class Key:
+    """One case key: its kind (a unit dimension, or number, integer, choice, text, …), default and meaning."""
+
+    kind: str
+    help: str
+    default: Any = None  # REQUIRED, None (optional, absent), or the value used when absent
+    lo: float = -math.inf
+    hi: float = math.inf
+    plausible: Optional[tuple] = None  # (lo, hi, text) in internal units: outside is refused as implausible
+    choices: tuple = ()
+    positive: bool = True  # quantities: must be > 0 (else ≥ 0)
+
+    def unit(self) -> str:
+        from fretsim.units import INTERNAL
+        return INTERNAL.get(self.kind, {"fraction": "% or fraction"}.get(self.kind, "–"))
+
+
+GEOMETRY_KEYS: dict[str, dict[str, Key]] = {
+    "cylinder_on_flat": {
+        "radius": Key("length", "cylinder radius R (Eq. 9)", REQUIRED, plausible=LENGTH_RANGE),
+        "length": Key("length", "cylinder length L along y (the line contact's length)", REQUIRED,
+                      plausible=LENGTH_RANGE)},
+    "ball_on_flat": {
+        "radius": Key("length", "ball radius R (Eq. 10)", REQUIRED, plausible=LENGTH_RANGE)},
+    "crossed_cylinders": {
+        "radius": Key("length", "radius R₁ of the moving cylinder", REQUIRED, plausible=LENGTH_RANGE),
+        "radius_stationary": Key("length", "radius R₂ of the stationary cylinder (default: R₁)", None,
+                                 plausible=LENGTH_RANGE),
+        "sliding": Key("choice", "the moving cylinder slides across its axis or along it", "across",
+                       choices=("across", "along"))},
+}
+
+SCHEMA: dict[str, dict[str, Key]] = {
+    "geometry": {"type": Key("choice", "the contact geometry", REQUIRED, choices=tuple(GEOMETRY_KEYS))},
+    "material": {  # each of materials.moving and materials.stationary
+        "youngs_modulus": Key("pressure", "Young's modulus E", REQUIRED, plausible=(1.0, 1e7, "1 MPa to 10 TPa")),
+        "poissons_ratio": Key("number", "Poisson's ratio ν", REQUIRED, lo=-1.0, hi=0.5),
+        "wear_coefficient": Key("wear_coefficient", "Archard wear coefficient k (Eqs. 14–16; includes hardness)",
+                                REQUIRED, plausible=(0.0, 1e-3, "0 to 1e-3 1/MPa"), positive=False)},
+    "loading": {
+        "normal_load": Key("force", "normal load P (total, both in 2D and 3D)", REQUIRED,
+                           plausible=(1e-6, 1e7, "1 µN to 10 MN")),
+        "stroke": Key("length", "slip amplitude δ (sliding distance 4δ per cycle)", REQUIRED,
+                      plausible=(1e-6, 10.0, "1 nm to 10 mm")),
+        "cycles": Key("integer", "fretting cycles N (0 solves the contact alone)", REQUIRED, lo=0, hi=MAX_CYCLES),
+        "friction_coefficient": Key("number", "friction coefficient μ: checks gross slip against Mindlin's "
+                                              "partial-slip limit (not used in the wear law)", None, lo=0.0,
+                                    hi=10.0)},
+    "model": {
+        "dimension": Key("choice", "2d (line contact per unit length), 3d, or auto: the cheapest within "
+                                   "model.accuracy", "auto", choices=DIMENSIONS),
+        "gap": Key("choice", "how the flat's wear enters the gap: mid_stroke (the paper, Eq. 18), stroke_average "
+                             "(stable for any wear coefficients) or auto", "auto", choices=GAP_MODELS),
+        "accuracy": Key("fraction", "largest difference from the full model accepted when `auto` simplifies it",
+                        0.01, lo=1e-4, hi=0.5)},
+    "solver": {
+        "method": Key("choice", "contact solver: cg (FFT, Polonsky–Keer), msm (the paper's simplex, dense), "
+                                "active_set (dense)", "cg", choices=("cg", "msm", "active_set")),
+        "tolerance": Key("number", "contact solver tolerance: relative change of the pressure in an iteration "
+                                   "(and the gap complementary)", 1e-5, lo=1e-14, hi=1e-2)},
+    "jumping": {
+        "scheme": Key("choice", "bdf2 (second-order implicit, default), implicit (backward Euler), linear "
+                                "(the paper's explicit ΔN_L) or adaptive (Eqs. 19–21)", None, choices=SCHEMES),
+        "tolerance": Key("fraction", "implicit schemes: target relative error of the recorded depths and "
+                                     "pressures", 0.01, lo=1e-6, hi=0.5),
+        "linear": Key("integer", "ΔN_L, cycles per explicit step (auto: half the stability limit)", None, lo=1,
+                      hi=MAX_CYCLES),
+        "eta": Key("number", "adaptive: accuracy parameter η (Eq. 21)", 0.55, lo=1e-6, hi=10.0),
+        "max": Key("integer", "adaptive: ΔN_max; implicit schemes: the largest step (auto: unbounded)", None, lo=1,
+                   hi=MAX_CYCLES),
+        "preset": Key("choice", "paper: the DOE optimum η 0.55, ΔN_max 600, ΔN_L 55 (scaled to the grid's "
+                                "stability limit if needed)", None, choices=tuple(PRESETS))},
+    "grid": {
+        "domain": Key("lengths", "[x, y] extents (one entry in 2D); automatic from the final scar if absent", None),
+        "elements": Key("counts", "[Mx, My] elements; automatic (7a/40) if absent", None, lo=1, hi=100_000),
+        "coarse_element": Key("lengths", "[dx, dy] of a coarse grid to solve the contact on (refinement, "
+                                         "Eqs. 11–12)", None)},
+    "output": {
+        "snapshots": Key("cycle_list", "cycles at which fields are written (+ the last); auto: 0, N/4, N/2, "
+                                       "3N/4, N", None)},
+}
+SECTIONS = ("name", "geometry", "materials", "loading", "model", "solver", "jumping", "grid", "output", "expected")
 
 
 class CaseError(Exception):
     """A case that cannot be run: every problem with its YAML path."""
 
-    def __init__(self, source: str, problems: list[tuple[str, str]]):
+    def __init__(self, source: str, problems: list[tuple[str, str]], what: str = "case"):
         self.source = source
         self.problems = problems
+        self.what = what
         super().__init__(str(self))
 
     def __str__(self) -> str:
-        head = f"{self.source}: the case has {len(self.problems)} problem{'s' if len(self.problems) > 1 else ''}"
+        n = len(self.problems)
+        if n == 1:
+            path, msg = self.problems[0]
+            return f"{self.source}: {path + ': ' if path else ''}{msg}"
+        head = f"{self.source}: the {self.what} has {n} problems"
         return head + ":\n" + "\n".join(f"  - {path}: {msg}" if path else f"  - {msg}" for path, msg in self.problems)
 
 
@@ -60,26 +142,30 @@ class Material:
 @dataclass(frozen=True)
 class Case:
     name: str
-    geometry: str
-    radius: float  # mm
-    length: Optional[float]  # mm (cylinder only)
+    geometry: Geometry
     moving: Material
     stationary: Material
     normal_load: float  # N (total)
     stroke: float  # mm, the amplitude δ (sliding distance per cycle 4δ)
     cycles: int
-    dimension: str
+    friction_coefficient: Optional[float] = None
+    dimension: str = "auto"
+    gap_model: str = "auto"
+    accuracy: float = 0.01
     solver: str = "cg"
-    tolerance: float = 1e-6  # contact solver; tighter changes depths by ~1e-10 (measured), costs ~30 % more
+    tolerance: float = 1e-5  # contact solver
+    scheme: str = "bdf2"
+    step_tolerance: float = 1e-2  # implicit schemes: target relative error at recorded states
     linear_jump: Optional[int] = None  # None: chosen from the stability limit
-    scheme: str = "implicit"  # implicit (controlled backward Euler) | linear | adaptive (paper Eqs. 19-21)
-    eta: float = 0.55  # adaptive: accuracy parameter η
-    max_jump: Optional[int] = None  # adaptive: ΔN_max; implicit: the largest step (None: unbounded)
-    step_tolerance: float = 1e-2  # implicit: local error per step relative to the current maximum depth
-    coarse_element: Optional[tuple[float, ...]] = None  # mm: solve the contact on this coarser grid (Eqs. 11-12)
-    domain: Optional[tuple[float, ...]] = None  # mm, (x, y) extents
+    eta: float = 0.55
+    max_jump: Optional[int] = None
+    preset: Optional[str] = None
+    coarse_element: Optional[tuple[float, ...]] = None  # mm
+    domain: Optional[tuple[float, ...]] = None  # mm
     elements: Optional[tuple[int, ...]] = None
     snapshots: Optional[tuple[int, ...]] = None
+    expected: dict = field(default_factory=dict, compare=False, hash=False)
+    overrides: tuple[str, ...] = field(default=(), compare=False)  # --set items as given
     source: str = field(default="<case>", compare=False)
 
     @property
@@ -91,9 +177,11 @@ class Case:
 
     def to_dict(self) -> dict:
         """The case with defaults filled, in the file layout, every dimensional value with its unit."""
-        geometry = {"type": self.geometry, "radius": format_quantity(self.radius, "length")}
-        if self.length is not None:
-            geometry["length"] = format_quantity(self.length, "length")
+        g = self.geometry
+        geometry: dict = {"type": g.kind}
+        for key, spec in GEOMETRY_KEYS[g.kind].items():
+            value = getattr(g, key)
+            geometry[key] = format_quantity(value, spec.kind) if spec.kind in ("length",) else value
 
         def mat(m: Material) -> dict:
             return {"youngs_modulus": format_quantity(m.youngs_modulus, "pressure"),
@@ -107,23 +195,32 @@ class Case:
             grid["elements"] = list(self.elements)
         if self.coarse_element is not None:
             grid["coarse_element"] = [format_quantity(d, "length") for d in self.coarse_element]
-        return {
+        loading = {"normal_load": format_quantity(self.normal_load, "force"),
+                   "stroke": format_quantity(self.stroke, "length"), "cycles": self.cycles}
+        if self.friction_coefficient is not None:
+            loading["friction_coefficient"] = self.friction_coefficient
+        jumping = {"scheme": self.scheme, "tolerance": self.step_tolerance,
+                   "linear": self.linear_jump if self.linear_jump is not None else "auto",
+                   "eta": self.eta, "max": self.max_jump if self.max_jump is not None else "auto"}
+        if self.preset is not None:
+            jumping["preset"] = self.preset
+        out = {
             "name": self.name,
             "geometry": geometry,
             "materials": {"moving": mat(self.moving), "stationary": mat(self.stationary)},
-            "loading": {"normal_load": format_quantity(self.normal_load, "force"),
-                        "stroke": format_quantity(self.stroke, "length"), "cycles": self.cycles},
-            "model": {"dimension": self.dimension},
+            "loading": loading,
+            "model": {"dimension": self.dimension, "gap": self.gap_model, "accuracy": self.accuracy},
             "solver": {"method": self.solver, "tolerance": self.tolerance},
-            "jumping": {"scheme": self.scheme,
-                        "linear": self.linear_jump if self.linear_jump is not None else "auto",
-                        "eta": self.eta, "max": self.max_jump if self.max_jump is not None else "auto",
-                        "tolerance": self.step_tolerance},
+            "jumping": jumping,
             "grid": grid,
             "output": {"snapshots": list(self.snapshots) if self.snapshots is not None else "auto"},
         }
+        if self.expected:
+            out["expected"] = self.expected
+        return out
 
     def to_yaml(self) -> str:
+        import yaml
         return yaml.safe_dump(self.to_dict(), sort_keys=False, allow_unicode=True)
 
 
@@ -132,23 +229,19 @@ def load_case(path: str | Path, overrides: Optional[list[str]] = None) -> Case:
     path = Path(path)
     source = str(path)
     try:
-        text = path.read_text()
-    except FileNotFoundError:
-        raise CaseError(source, [("", "the file does not exist")]) from None
-    except (OSError, UnicodeDecodeError) as exc:
-        raise CaseError(source, [("", f"cannot read the file: {exc}")]) from None
+        text = read_text(path, "case file")
+    except (OSError, ValueError) as exc:
+        raise CaseError(source, [("", str(exc) if not isinstance(exc, FileNotFoundError) or exc.args
+                                  else "the file does not exist")]) from None
     return parse_case(text, source=source, overrides=overrides, default_name=path.stem)
 
 
 def parse_case(text: str, source: str = "<case>", overrides: Optional[list[str]] = None,
                default_name: str = "case") -> Case:
     try:
-        raw = yaml.safe_load(text)
-    except yaml.YAMLError as exc:
-        mark = getattr(exc, "problem_mark", None)
-        where = f"line {mark.line + 1}, column {mark.column + 1}: " if mark else ""
-        problem = getattr(exc, "problem", None) or str(exc).splitlines()[0]
-        raise CaseError(source, [("", f"YAML syntax error at {where}{problem}")]) from None
+        raw = loads(text)
+    except YamlProblem as exc:
+        raise CaseError(source, [(exc.path, exc.message)]) from None
     if raw is None:
         raise CaseError(source, [("", "the file is empty; expected a YAML mapping with the sections "
                                       + ", ".join(SECTIONS))])
@@ -158,7 +251,7 @@ def parse_case(text: str, source: str = "<case>", overrides: Optional[list[str]]
     problems: list[tuple[str, str]] = []
     for item in overrides or []:
         _apply_override(raw, item, problems)
-    case = _validate(raw, problems, source, default_name)
+    case = _validate(raw, problems, source, default_name, tuple(overrides or ()))
     if problems:
         raise CaseError(source, problems)
     return case
@@ -166,33 +259,23 @@ def parse_case(text: str, source: str = "<case>", overrides: Optional[list[str]]
 
 def _apply_override(raw: dict, item: str, problems: list) -> None:
     key, sep, value = item.partition("=")
-    if not sep or not key.strip():
-        problems.append((f"--set {item}", "expected key.path=value, e.g. loading.cycles=1000"))
-        return
     parts = key.strip().split(".")
+    if not sep or not key.strip() or not all(parts):
+        problems.append((f"--set {excerpt(item, 60)}", "expected key.path=value, e.g. loading.cycles=1000"))
+        return
     node = raw
     for part in parts[:-1]:
         if not isinstance(node.get(part), dict):
             node[part] = {}
         node = node[part]
     try:
-        node[parts[-1]] = yaml.safe_load(value) if value.strip() else None
-    except yaml.YAMLError:
-        node[parts[-1]] = value
-
-
-def _plain_number(v: Any) -> Any:
-    """YAML 1.1 reads 1e-8 (no dot) as text; accept such numerals as the numbers they are."""
-    if isinstance(v, str):
-        try:
-            return float(v.strip()) if v.strip().lower() not in ("nan", "inf", "-inf", "+inf", "infinity") else v
-        except ValueError:
-            return v
-    return v
+        node[parts[-1]] = loads(value) if value.strip() else None
+    except YamlProblem as exc:
+        problems.append((f"--set {key.strip()}", exc.message))
 
 
 class _Reader:
-    """Collects problems while reading typed values out of the raw mapping."""
+    """Collects problems while reading typed values out of the raw mapping, as the schema says."""
 
     def __init__(self, problems: list):
         self.problems = problems
@@ -200,7 +283,7 @@ class _Reader:
     def fail(self, path: str, msg: str) -> None:
         self.problems.append((path, msg))
 
-    def section(self, raw: dict, name: str, keys: set, required: bool = True) -> Optional[dict]:
+    def section(self, raw: dict, name: str, keys, required: bool = True) -> Optional[dict]:
         """The section's mapping ({} if optional and absent); None, with the problem recorded, if unusable."""
         value = raw.get(name)
         if value is None:
@@ -209,114 +292,169 @@ class _Reader:
                 return None
             return {}
         if not isinstance(value, dict):
-            self.fail(name, f"expected a mapping with keys {', '.join(sorted(keys))}, got a {type(value).__name__}")
+            self.fail(name, f"expected a mapping with keys {', '.join(sorted(keys))}, got {excerpt(value)}")
             return None if required else {}
         self.unknown(value, keys, name)
         return value
 
-    def unknown(self, mapping: dict, keys: set, prefix: str) -> None:
+    def unknown(self, mapping: dict, keys, prefix: str) -> None:
         for k in mapping:
             if k not in keys:
                 hint = difflib.get_close_matches(str(k), keys, n=1, cutoff=0.6)
-                self.fail(f"{prefix}.{k}" if prefix else str(k), "unknown key" + (
+                name = excerpt(k) if not isinstance(k, str) else k[:40]
+                self.fail(f"{prefix}.{name}" if prefix else name, "unknown key" + (
                     f" (did you mean '{hint[0]}'?)" if hint else f"; allowed: {', '.join(sorted(keys))}"))
 
-    def quantity(self, mapping: dict, key: str, prefix: str, dimension: str, required: bool = True,
-                 positive: bool = True, plausible: Optional[tuple[float, float, str]] = None) -> Optional[float]:
-        path = f"{prefix}.{key}"
-        if key not in mapping or mapping[key] is None:
-            if required:
-                self.fail(path, f"missing; expected a {dimension.replace('_', ' ')} with its unit")
+    def key(self, mapping: Optional[dict], name: str, spec: Key, path: str) -> Any:
+        """Read one key as its schema says; the default if absent; None (with a problem) if bad."""
+        if mapping is None:
             return None
+        value = mapping.get(name)
+        if value is None or (value == "auto" and spec.kind not in ("choice", "text")):
+            if spec.default is REQUIRED:
+                self.fail(path, f"missing; expected {_expected(spec)}")
+            return None if spec.default is REQUIRED else spec.default
+        return self.value(value, spec, path)
+
+    def value(self, value: Any, spec: Key, path: str) -> Any:
+        kind = spec.kind
+        if kind in ("length", "force", "pressure", "wear_coefficient"):
+            return self.quantity(value, spec, path)
+        if kind == "number":
+            return self.number(value, spec, path)
+        if kind == "fraction":
+            if isinstance(value, str) and value.strip().endswith("%"):
+                num = value.strip()[:-1].strip()
+                try:
+                    value = float(num) / 100.0
+                except ValueError:
+                    self.fail(path, f"could not read {excerpt(value)}; expected e.g. '1 %' or 0.01")
+                    return None
+            return self.number(value, spec, path)
+        if kind == "integer":
+            return self.integer(value, spec, path)
+        if kind == "choice":
+            if isinstance(value, str) and value.lower() in spec.choices:
+                return value.lower()
+            hint = difflib.get_close_matches(str(value).lower(), spec.choices, n=1) if isinstance(value, str) else []
+            self.fail(path, f"unknown value {excerpt(value)}" + (f" (did you mean '{hint[0]}'?)" if hint else "")
+                      + f"; expected one of {', '.join(spec.choices)}")
+            return None
+        if kind in ("lengths", "counts"):
+            item = Key("length", "") if kind == "lengths" else Key("integer", "", lo=spec.lo, hi=spec.hi)
+            if not isinstance(value, list) or not 1 <= len(value) <= 2:
+                self.fail(path, f"expected a list of one (2d) or two (3d) {'lengths' if kind == 'lengths' else 'whole numbers'}"
+                                f", e.g. {'[1 mm, 10 mm]' if kind == 'lengths' else '[101, 27]'}")
+                return None
+            vals = [self.value(v, item, f"{path}[{i}]") for i, v in enumerate(value)]
+            return None if None in vals else tuple(vals)
+        if kind == "cycle_list":
+            if not isinstance(value, list):
+                self.fail(path, "expected a list of cycle numbers, e.g. [1000, 5000, 18000]")
+                return None
+            if len(value) > 10_000:
+                self.fail(path, f"{len(value)} snapshots; at most 10000")
+                return None
+            vals = [self.integer(v, Key("integer", "", lo=0, hi=MAX_CYCLES), f"{path}[{i}]")
+                    for i, v in enumerate(value)]
+            return None if None in vals else tuple(sorted(set(vals)))
+        raise AssertionError(kind)
+
+    def quantity(self, value: Any, spec: Key, path: str) -> Optional[float]:
         try:
-            v = parse_quantity(mapping[key], dimension)
+            v = parse_quantity(value, spec.kind)
         except UnitError as exc:
             self.fail(path, str(exc))
             return None
-        if positive and not v > 0:
-            self.fail(path, f"must be positive, got {mapping[key]!r}")
+        if spec.positive and not v > 0:
+            self.fail(path, f"must be positive, got {excerpt(value)}")
             return None
-        if plausible is not None and not plausible[0] <= v <= plausible[1]:
-            self.fail(path, f"{mapping[key]!r} is outside the plausible range {plausible[2]} for a fretting contact: "
-                            f"check the value and its unit")
+        if not spec.positive and v < 0:
+            self.fail(path, f"must not be negative, got {excerpt(value)}")
+            return None
+        if spec.plausible is not None and not spec.plausible[0] <= v <= spec.plausible[1]:
+            self.fail(path, f"{excerpt(value)} is outside the plausible range {spec.plausible[2]} for a fretting "
+                            f"contact: check the value and its unit")
             return None
         return v
 
-    def number(self, mapping: dict, key: str, path: str, lo: float, hi: float, required: bool = True,
-               default: Optional[float] = None, open_hi: bool = False) -> Optional[float]:
-        if key not in mapping or mapping[key] is None:
-            if required:
-                self.fail(path, f"missing; expected a number in [{lo}, {hi}{')' if open_hi else ']'}")
-            return default
-        v = _plain_number(mapping[key])
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            self.fail(path, f"expected a plain number, got {v!r}")
+    def number(self, value: Any, spec: Key, path: str) -> Optional[float]:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            self.fail(path, f"expected a plain number, got {excerpt(value)}")
             return None
-        if not (lo <= v <= hi) or (open_hi and v >= hi):
-            self.fail(path, f"{v!r} is out of range; expected a number in [{lo}, {hi}{')' if open_hi else ']'}")
+        try:
+            v = float(value)
+        except OverflowError:
+            self.fail(path, f"{excerpt(value)} is out of range; expected {_expected(spec)}")
             return None
-        return float(v)
+        if not math.isfinite(v):
+            self.fail(path, f"expected a finite number, got {excerpt(value)}")
+            return None
+        hi_open = spec.kind == "number" and spec.hi == 0.5  # Poisson's ratio: (−1, 0.5)
+        if not (spec.lo <= v <= spec.hi) or (hi_open and v >= spec.hi) or (spec.lo == -1.0 and v <= -1.0):
+            self.fail(path, f"{excerpt(value)} is out of range; expected {_expected(spec)}")
+            return None
+        return v
 
-    def integer(self, value: Any, path: str, lo: int, hi: int) -> Optional[int]:
-        value = _plain_number(value)
+    def integer(self, value: Any, spec: Key, path: str) -> Optional[int]:
         if isinstance(value, bool) or not isinstance(value, (int, float)) or (
                 isinstance(value, float) and not (math.isfinite(value) and value.is_integer())):
-            self.fail(path, f"expected a whole number, got {value!r}")
+            self.fail(path, f"expected a whole number, got {excerpt(value)}")
             return None
-        if not lo <= value <= hi:
-            self.fail(path, f"{value!r} is out of range; expected a whole number from {lo} to {hi}")
+        if not spec.lo <= value <= spec.hi:
+            self.fail(path, f"{excerpt(value)} is out of range; expected a whole number from {spec.lo:.0f} to "
+                            f"{spec.hi:.0f}")
             return None
         return int(value)
 
-    def vector(self, mapping: dict, key: str, want: int, item, expected: str) -> Optional[tuple]:
-        """A list of one (2d) or two (3d) items, each read by ``item(value, path)``; None if absent or bad."""
-        path = f"grid.{key}"
-        value = mapping.get(key) if mapping else None
-        if value is None:
-            return None
-        if not isinstance(value, list) or not 1 <= len(value) <= 2:
-            self.fail(path, f"expected a list {expected}")
-            return None
-        vals = [item(v, f"{path}[{i}]") for i, v in enumerate(value)]
-        if len(value) < want:
-            self.fail(path, f"a 3d case needs two entries: {expected}")
-            return None
-        return None if None in vals else tuple(vals[:want])
 
-    def choice(self, mapping: dict, key: str, path: str, options: tuple, default: Optional[str] = None):
-        v = mapping.get(key, default)
-        if v is None:
-            self.fail(path, f"missing; expected one of {', '.join(options)}")
-            return None
-        if v not in options:
-            hint = difflib.get_close_matches(str(v), options, n=1)
-            self.fail(path, f"unknown value {v!r}" + (f" (did you mean '{hint[0]}'?)" if hint else "")
-                      + f"; expected one of {', '.join(options)}")
-            return None
-        return v
+def _expected(spec: Key) -> str:
+    kind = spec.kind
+    if kind in ("length", "force", "pressure", "wear_coefficient"):
+        from fretsim.units import example
+        return f"a {kind.replace('_', ' ')} with its unit, e.g. '{example(kind)}'"
+    if kind == "choice":
+        return "one of " + ", ".join(spec.choices)
+    if kind in ("number", "fraction"):
+        hi = ")" if spec.hi == 0.5 else "]"
+        lo = "(" if spec.lo == -1.0 else "["
+        return f"a number in {lo}{spec.lo:g}, {spec.hi:g}{hi}" + (" (or a percentage, e.g. '1 %')"
+                                                                    if kind == "fraction" else "")
+    if kind == "integer":
+        return f"a whole number from {spec.lo:.0f} to {spec.hi:.0f}"
+    return spec.help
 
 
-def _validate(raw: dict, problems: list, source: str, default_name: str) -> Optional[Case]:
-    from fretsim.solvers import SOLVERS  # the registry decides which names are valid
-
+def _validate(raw: dict, problems: list, source: str, default_name: str, overrides: tuple) -> Optional[Case]:
     r = _Reader(problems)
     r.unknown(raw, set(SECTIONS), "")
     name = raw.get("name", default_name)
     if not isinstance(name, (str, int, float)) or isinstance(name, bool):
-        r.fail("name", f"expected a text, got a {type(name).__name__}")
+        r.fail("name", f"expected a text, got {excerpt(name)}")
         name = default_name
     name = str(name)
+    if len(name) > 200:
+        r.fail("name", f"a name of {len(name)} characters; at most 200")
 
-    geo = r.section(raw, "geometry", SECTIONS["geometry"])
-    gtype = r.choice(geo, "type", "geometry.type", GEOMETRIES) if geo is not None else None
-    radius = r.quantity(geo, "radius", "geometry", "length", plausible=LENGTH_RANGE) if geo is not None else None
-    length = None
-    if gtype == "cylinder_on_flat":
-        length = r.quantity(geo, "length", "geometry", "length", plausible=LENGTH_RANGE)
-    elif gtype == "ball_on_flat" and geo.get("length") is not None:
-        r.fail("geometry.length", "a ball has no axial length; remove this key")
+    geo = r.section(raw, "geometry", {"type"} | {k for keys in GEOMETRY_KEYS.values() for k in keys})
+    gtype = r.key(geo, "type", SCHEMA["geometry"]["type"], "geometry.type") if geo is not None else None
+    geometry = None
+    if gtype is not None:
+        keys = GEOMETRY_KEYS[gtype]
+        for k in geo:
+            if k != "type" and k not in keys:
+                r.fail(f"geometry.{k}", f"a {gtype} has no {k}; its keys are {', '.join(keys)}")
+        vals = {k: r.key(geo, k, spec, f"geometry.{k}") for k, spec in keys.items()}
+        if all(v is not None for k, v in vals.items() if keys[k].default is REQUIRED):
+            if gtype == "cylinder_on_flat":
+                geometry = CylinderOnFlat(vals["radius"], vals["length"])
+            elif gtype == "ball_on_flat":
+                geometry = BallOnFlat(vals["radius"])
+            elif gtype == "crossed_cylinders" and vals["sliding"] is not None:
+                geometry = CrossedCylinders(vals["radius"], vals["radius_stationary"] or vals["radius"],
+                                            vals["sliding"])
 
-    mats = r.section(raw, "materials", SECTIONS["materials"])
+    mats = r.section(raw, "materials", {"moving", "stationary"})
     materials = {}
     for body in ("moving", "stationary"):
         if mats is None:
@@ -325,92 +463,58 @@ def _validate(raw: dict, problems: list, source: str, default_name: str) -> Opti
         path = f"materials.{body}"
         if not isinstance(m, dict):
             r.fail(path, "missing; expected a mapping with youngs_modulus, poissons_ratio, wear_coefficient"
-                   if m is None else f"expected a mapping, got a {type(m).__name__}")
+                   if m is None else f"expected a mapping, got {excerpt(m)}")
             continue
-        r.unknown(m, MATERIAL_KEYS, path)
-        e = r.quantity(m, "youngs_modulus", path, "pressure", plausible=(1.0, 1e7, "1 MPa to 10 TPa"))
-        nu = r.number(m, "poissons_ratio", f"{path}.poissons_ratio", -1.0, 0.5, open_hi=True)
-        if nu is not None and nu <= -1.0:
-            r.fail(f"{path}.poissons_ratio", "must be greater than -1")
-            nu = None
-        k = r.quantity(m, "wear_coefficient", path, "wear_coefficient", positive=False,
-                       plausible=(0.0, 1e-3, "0 to 1e-3 1/MPa"))
-        if k is not None and k < 0:
-            r.fail(f"{path}.wear_coefficient", f"must not be negative, got {m['wear_coefficient']!r}")
-            k = None
-        if None not in (e, nu, k):
-            materials[body] = Material(e, nu, k)
+        r.unknown(m, SCHEMA["material"], path)
+        vals = [r.key(m, k, spec, f"{path}.{k}") for k, spec in SCHEMA["material"].items()]
+        if None not in vals:
+            materials[body] = Material(*vals)
 
-    load = r.section(raw, "loading", SECTIONS["loading"])
-    normal_load = r.quantity(load, "normal_load", "loading", "force", plausible=(1e-6, 1e7, "1 µN to 10 MN")) \
-        if load is not None else None
-    stroke = r.quantity(load, "stroke", "loading", "length", plausible=(1e-6, 10.0, "1 nm to 10 mm")) \
-        if load is not None else None
-    cycles = None
-    if load is not None:
-        if "cycles" not in load:
-            r.fail("loading.cycles", "missing; expected a whole number of cycles (0 solves the contact alone)")
-        else:
-            cycles = r.integer(load["cycles"], "loading.cycles", 0, MAX_CYCLES)
+    def read(section: str, required: bool = False) -> dict:
+        mapping = r.section(raw, section, SCHEMA[section], required=required)
+        return {k: r.key(mapping, k, spec, f"{section}.{k}") for k, spec in SCHEMA[section].items()} \
+            if mapping is not None else {}
 
-    model = r.section(raw, "model", SECTIONS["model"], required=False)
-    dimension = r.choice(model, "dimension", "model.dimension", DIMENSIONS, default="3d")
-    if dimension == "2d" and gtype == "ball_on_flat":
-        r.fail("model.dimension", "a ball on a flat is a point contact: it needs 3d (2d is a line contact)")
+    load = read("loading", required=True)
+    model = read("model")
+    solver = read("solver")
+    jumping_raw = raw.get("jumping") if isinstance(raw.get("jumping"), dict) else {}
+    jumping = read("jumping")
+    grid = read("grid")
+    output = read("output")
+    expected = raw.get("expected", {})
+    if not isinstance(expected, dict):
+        r.fail("expected", f"expected a mapping of published values, got {excerpt(expected)}")
+        expected = {}
 
-    solver = r.section(raw, "solver", SECTIONS["solver"], required=False)
-    method = r.choice(solver, "method", "solver.method", tuple(SOLVERS), default="cg")
-    tolerance = r.number(solver, "tolerance", "solver.tolerance", 1e-14, 1e-2, required=False, default=1e-6)
+    preset = jumping.get("preset")
+    if preset is not None:
+        for k, v in PRESETS[preset].items():
+            if jumping_raw.get(k) in (None, "auto") and k != "linear":
+                jumping[k if k != "max" else "max"] = v
+    scheme = jumping.get("scheme")
+    if scheme is None:
+        # a block giving only `linear` keeps its original meaning: explicit linear jumping
+        scheme = "linear" if jumping.get("linear") is not None and preset is None else "bdf2"
+    dimension = model.get("dimension")
+    if geometry is not None and dimension == "2d" and not geometry.has_2d:
+        r.fail("model.dimension", f"a {geometry.kind} is a point contact: it needs 3d (2d is a line contact)")
 
-    jumping = dict(r.section(raw, "jumping", SECTIONS["jumping"], required=False))
-    if "preset" in jumping:
-        preset = r.choice(jumping, "preset", "jumping.preset", tuple(PRESETS))
-        jumping = {**PRESETS.get(preset, {}), **{k: v for k, v in jumping.items() if k != "preset"}}
-    # a block giving only `linear` keeps its original meaning: explicit linear jumping
-    default_scheme = "linear" if "linear" in jumping and jumping["linear"] not in ("auto", None) else "implicit"
-    scheme = r.choice(jumping, "scheme", "jumping.scheme", SCHEMES, default=default_scheme)
-    linear = jumping.get("linear", "auto")
-    linear_jump = None
-    if linear not in ("auto", None):
-        linear_jump = r.integer(linear, "jumping.linear", 1, MAX_CYCLES)
-    eta = r.number(jumping, "eta", "jumping.eta", 1e-6, 10.0, required=False, default=0.55)
-    max_jump = None
-    if jumping.get("max", "auto") not in ("auto", None):
-        max_jump = r.integer(jumping["max"], "jumping.max", 1, MAX_CYCLES)
-    step_tolerance = r.number(jumping, "tolerance", "jumping.tolerance", 1e-8, 0.5, required=False, default=1e-2)
-
-    grid = r.section(raw, "grid", SECTIONS["grid"], required=False)
-    want = 1 if dimension == "2d" else 2
-
-    def length_item(v, path):
-        return r.quantity({"v": v}, "v", path, "length")
-
-    def count_item(v, path):
-        return r.integer(v, path, 1, 100_000)
-
-    domain = r.vector(grid, "domain", want, length_item, "[x extent, y extent] of lengths, e.g. [1 mm, 10 mm]")
-    elements = r.vector(grid, "elements", want, count_item, "[Mx, My] of whole numbers, e.g. [101, 27]")
-    coarse = r.vector(grid, "coarse_element", want, length_item,
-                      "[dx, dy] of lengths, e.g. [15.75 um, 1000 um]")
-
-    output = r.section(raw, "output", SECTIONS["output"], required=False)
-    snaps = output.get("snapshots", "auto")
-    snapshots = None
-    if snaps not in ("auto", None):
-        if not isinstance(snaps, list):
-            r.fail("output.snapshots", "expected a list of cycle numbers, e.g. [1000, 5000, 18000]")
-        else:
-            vals = [r.integer(v, f"output.snapshots[{i}]", 0, MAX_CYCLES) for i, v in enumerate(snaps)]
-            if None not in vals:
-                snapshots = tuple(sorted(set(vals)))
-
+    domain, elements, coarse = grid.get("domain"), grid.get("elements"), grid.get("coarse_element")
+    stroke = load.get("stroke")
     if domain is not None and stroke is not None and stroke >= domain[0] / 2:
-        r.fail("loading.stroke", f"the stroke amplitude {load['stroke']!r} is larger than half the grid's "
-                                 f"x extent ({domain[0]:.4g} mm): check its unit")
-    if problems:
+        r.fail("loading.stroke", f"the stroke amplitude {format_quantity(stroke, 'length')} is larger than half "
+                                 f"the grid's x extent ({domain[0]:.4g} mm): check its unit")
+    if problems or geometry is None:
+        if not problems:
+            r.fail("geometry", "incomplete")
         return None
-    return Case(name=name, geometry=gtype, radius=radius, length=length, moving=materials["moving"],
-                stationary=materials["stationary"], normal_load=normal_load, stroke=stroke, cycles=cycles,
-                dimension=dimension, solver=method, tolerance=tolerance, linear_jump=linear_jump, scheme=scheme,
-                eta=eta, max_jump=max_jump, step_tolerance=step_tolerance, coarse_element=coarse, domain=domain,
-                elements=elements, snapshots=snapshots, source=source)
+    return Case(name=name, geometry=geometry, moving=materials["moving"], stationary=materials["stationary"],
+                normal_load=load["normal_load"], stroke=stroke, cycles=load["cycles"],
+                friction_coefficient=load.get("friction_coefficient"), dimension=dimension,
+                gap_model=model["gap"], accuracy=model["accuracy"], solver=solver["method"],
+                tolerance=solver["tolerance"], scheme=scheme, step_tolerance=jumping["tolerance"],
+                linear_jump=jumping.get("linear") if scheme in ("linear", "adaptive") else jumping.get("linear"),
+                eta=jumping["eta"], max_jump=jumping.get("max"), preset=preset, coarse_element=coarse,
+                domain=domain, elements=elements, snapshots=output.get("snapshots"), expected=expected,
+                overrides=overrides, source=source)

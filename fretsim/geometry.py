@@ -1,21 +1,192 @@
-"""Initial separation ε between the undeformed bodies at the centre of the stroke (paper Eqs. 9–10)."""
+"""The contact geometries, one small object each: initial separation, Hertz estimate, 2D model, limits.
+
+Every geometry knows
+
+* ``separation(grid)`` — the initial gap ε between the undeformed bodies at mid-stroke (paper Eqs. 9–10),
+  +inf where they cannot touch (beyond a cylinder's ends);
+* ``hertz(load, e_star)`` — the Hertz contact it starts from (half-widths along x and y, peak pressure),
+  which sizes the grid;
+* ``line_length`` — the contact length of a line contact (its 2D model carries load per unit length),
+  None for a point contact, which has no 2D model;
+* ``limits`` — where the geometry stops describing the body (worn through, the paraboloid of Eqs. 9–10 no
+  longer the circle);
+* ``extra_compliance(grid, moving)`` — an operator to add to the half-space's (the tube's ring bending),
+  or None.
+
+x is the sliding direction, y across it; the moving body is the one that slides.  All lengths in mm.
+"""
 from __future__ import annotations
 
-from typing import Optional
+import math
+from dataclasses import dataclass, field
+from typing import ClassVar, Optional
 
 import numpy as np
 
 from fretsim.grid import Grid
+from fretsim.reference import hertz_elliptical, hertz_line
 
 
-def initial_separation(kind: str, grid: Grid, radius: float, length: Optional[float] = None) -> np.ndarray:
-    """ε (mm) on the grid; +inf where the bodies cannot touch (beyond a cylinder's ends)."""
+@dataclass(frozen=True)
+class HertzEstimate:
+    """The unworn contact: half-widths along x and y (mm), peak pressure (MPa); ``line`` for line contacts."""
+
+    half_width_x: float
+    half_width_y: float
+    peak_pressure: float
+    line: bool
+
+
+@dataclass(frozen=True)
+class Limits:
+    """Where the geometry stops meaning anything: the moving body worn through ``wear_depth`` (mm), or the
+    contact reaching ``reach_x`` from the centre along x (and ``reach_y`` along y, None for a line contact)."""
+
+    wear_depth: float
+    reach_x: float
+    reach_y: Optional[float]
+    wear_what: str  # what "worn through" means for this body, for the message
+
+
+class Geometry:
+    """Base of the family; subclasses are frozen dataclasses registered in :data:`GEOMETRIES`."""
+
+    kind: ClassVar[str]
+    line_length: Optional[float] = None
+
+    def separation(self, grid: Grid) -> np.ndarray:
+        raise NotImplementedError
+
+    def hertz(self, load: float, e_star: float) -> HertzEstimate:
+        raise NotImplementedError
+
+    @property
+    def limits(self) -> Limits:
+        raise NotImplementedError
+
+    @property
+    def has_2d(self) -> bool:
+        return self.line_length is not None
+
+    @property
+    def y_edges_free(self) -> bool:
+        """True when the contact may end at the grid's y edges (the ends of a line contact)."""
+        return self.line_length is not None
+
+    def extra_compliance(self, grid: Grid, youngs_modulus: float, poissons_ratio: float):
+        return None
+
+    def scar_half_widths(self, volume: float) -> tuple[float, float]:
+        """Half-widths (mm) along x and y of a scar holding the worn ``volume`` (mm³) of both bodies (sizing).
+
+        A cylinder worn to a circular segment of half-width b holds V ≈ 2b³L/(3R); the paraboloid
+        x²/(2Rx) + y²/(2Ry) cut at depth h holds V = πh²√(RxRy), over half-widths √(2Rx·h), √(2Ry·h).
+        """
+        raise NotImplementedError
+
+
+def _cap_half_widths(volume: float, rx: float, ry: float) -> tuple[float, float]:
+    depth = math.sqrt(volume / (math.pi * math.sqrt(rx * ry)))
+    return math.sqrt(2 * rx * depth), math.sqrt(2 * ry * depth)
+
+
+def _line_gap(grid: Grid, radius: float, length: float, drop: Optional[np.ndarray] = None) -> np.ndarray:
     X, Y = grid.mesh()
-    if kind == "cylinder_on_flat":
-        gap = X**2 / (2.0 * radius)  # Eq. 9
-        if not grid.plane_strain and length is not None:
-            gap = np.where(np.abs(Y) <= length / 2.0 + 1e-12 * length, gap, np.inf)
+    gap = X**2 / (2.0 * radius)  # Eq. 9
+    if grid.plane_strain:
         return gap
-    if kind == "ball_on_flat":
-        return (X**2 + Y**2) / (2.0 * radius)  # Eq. 10
-    raise ValueError(f"unknown geometry {kind!r}")
+    if drop is not None:
+        gap = gap + drop[:, None]
+    return np.where(np.abs(Y) <= length / 2.0 + 1e-12 * length, gap, np.inf)
+
+
+@dataclass(frozen=True)
+class CylinderOnFlat(Geometry):
+    """A cylinder of radius R and length L, axis along y, on a flat (paper Eq. 9)."""
+
+    kind: ClassVar[str] = "cylinder_on_flat"
+    radius: float
+    length: float
+
+    @property
+    def line_length(self) -> float:
+        return self.length
+
+    def separation(self, grid: Grid) -> np.ndarray:
+        return _line_gap(grid, self.radius, self.length)
+
+    def hertz(self, load: float, e_star: float) -> HertzEstimate:
+        h = hertz_line(load / self.length, self.radius, e_star)
+        return HertzEstimate(h.half_width, self.length / 2, h.peak_pressure, True)
+
+    @property
+    def limits(self) -> Limits:
+        return Limits(self.radius, self.radius / 2, None, f"its radius {self.radius:.4g} mm")
+
+    def scar_half_widths(self, volume: float) -> tuple[float, float]:
+        return (1.5 * self.radius * volume / self.length) ** (1 / 3), self.length / 2
+
+
+@dataclass(frozen=True)
+class BallOnFlat(Geometry):
+    """A ball of radius R on a flat (paper Eq. 10)."""
+
+    kind: ClassVar[str] = "ball_on_flat"
+    radius: float
+
+    def separation(self, grid: Grid) -> np.ndarray:
+        X, Y = grid.mesh()
+        return (X**2 + Y**2) / (2.0 * self.radius)  # Eq. 10
+
+    def hertz(self, load: float, e_star: float) -> HertzEstimate:
+        h = hertz_elliptical(load, self.radius, self.radius, e_star)
+        return HertzEstimate(h.ax, h.ay, h.peak_pressure, False)
+
+    @property
+    def limits(self) -> Limits:
+        return Limits(self.radius, self.radius / 2, self.radius / 2, f"its radius {self.radius:.4g} mm")
+
+    def scar_half_widths(self, volume: float) -> tuple[float, float]:
+        return _cap_half_widths(volume, self.radius, self.radius)
+
+
+@dataclass(frozen=True)
+class CrossedCylinders(Geometry):
+    """Two cylinders crossed at right angles (wire ropes, paper section 4.1, Fig. 20).
+
+    The moving cylinder (radius R₁) slides ``across`` its axis (axis along y) or ``along`` it (axis along x);
+    the stationary one (radius R₂) lies at right angles.  The gap is x²/(2Rx) + y²/(2Ry) with (Rx, Ry) =
+    (R₁, R₂) or (R₂, R₁): with R₁ = R₂ it is the ball's (Eq. 10), otherwise the contact is elliptical.
+    """
+
+    kind: ClassVar[str] = "crossed_cylinders"
+    radius: float  # moving cylinder R₁
+    radius_stationary: float  # R₂
+    sliding: str = "across"
+
+    @property
+    def radii_xy(self) -> tuple[float, float]:
+        r1, r2 = self.radius, self.radius_stationary
+        return (r1, r2) if self.sliding == "across" else (r2, r1)
+
+    def separation(self, grid: Grid) -> np.ndarray:
+        rx, ry = self.radii_xy
+        X, Y = grid.mesh()
+        return X**2 / (2.0 * rx) + Y**2 / (2.0 * ry)
+
+    def hertz(self, load: float, e_star: float) -> HertzEstimate:
+        rx, ry = self.radii_xy
+        h = hertz_elliptical(load, rx, ry, e_star)
+        return HertzEstimate(h.ax, h.ay, h.peak_pressure, False)
+
+    @property
+    def limits(self) -> Limits:
+        rx, ry = self.radii_xy
+        return Limits(min(self.radius, self.radius_stationary), rx / 2, ry / 2,
+                      f"the smaller radius {min(self.radius, self.radius_stationary):.4g} mm")
+
+    def scar_half_widths(self, volume: float) -> tuple[float, float]:
+        return _cap_half_widths(volume, *self.radii_xy)
+
+
+GEOMETRIES: dict[str, type] = {g.kind: g for g in (CylinderOnFlat, BallOnFlat, CrossedCylinders)}

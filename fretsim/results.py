@@ -44,9 +44,11 @@ HISTORY = {
     "wall_time": ("s", lambda s: s.wall_time),
     "approach": ("um", lambda s: s.approach * 1e3),
     "archard_volume_error": ("1", lambda s: s.archard_error),
-    "checkerboard_amplitude": ("1", lambda s: s.checkerboard),
+    "checkerboard_amplitude": ("1", lambda s: abs(s.checkerboard)),
     "cycle_jump": ("cycles", lambda s: s.jump),
     "rejected_steps": ("1", lambda s: s.rejected),
+    "error_estimate_depth": ("1", lambda s: s.error_depth),
+    "error_estimate_pressure": ("1", lambda s: s.error_pressure),
 }
 INTEGER_HISTORY = {"cycle", "solver_iterations", "cycle_jump", "rejected_steps"}
 FIELDS = {
@@ -61,7 +63,8 @@ SUMMARY_UNITS = {
     "centre_wear_depth_stationary_um": "um", "scar_width_stationary_mm": "mm", "wear_volume_moving_mm3": "mm^3",
     "wear_volume_stationary_mm3": "mm^3", "archard_volume_error": "1", "max_pressure_MPa": "MPa",
     "linear_jump": "cycles", "stability_limit_linear": "cycles", "element_size_x_um": "um",
-    "element_size_y_um": "um", "elements_x": "1", "elements_y": "1",
+    "element_size_y_um": "um", "elements_x": "1", "elements_y": "1", "scar_width_moving_mm": "mm",
+    "error_estimate_depth": "1", "error_estimate_pressure": "1",
 }
 
 
@@ -73,11 +76,12 @@ class ResultsWriter:
     """
 
     def __init__(self, path: str | Path, case_yaml: str, case_name: str, grid, notes=(), overwrite: bool = False,
-                 previous: Optional["Results"] = None):
+                 previous: Optional["Results"] = None, choices=()):
         self.path = Path(path)
         if self.path.exists() and not overwrite and previous is None:
             raise FileExistsError(f"{self.path} exists")
         self.case_yaml, self.case_name, self.grid, self.notes = case_yaml, case_name, grid, tuple(notes)
+        self.choices = tuple(choices)
         if previous is not None:
             self.rows = [list(r) for r in zip(*(previous.history[k] for k in HISTORY))] if len(
                 previous.history.get("cycle", [])) else []
@@ -138,6 +142,12 @@ class ResultsWriter:
         for name, (units, _) in FIELDS.items():
             data = np.array(self.fields[name]).reshape(len(self.fields[name]), ny, nx)
             fl.create_dataset(name, data=data).attrs["units"] = units
+        ch = f.create_group("choices")
+        text = h5py.string_dtype()
+        ch.create_dataset("key", data=[c.key for c in self.choices], dtype=text)
+        ch.create_dataset("value", data=[_value_text(c.value) for c in self.choices], dtype=text)
+        ch.create_dataset("reason", data=[c.reason for c in self.choices], dtype=text)
+        ch.create_dataset("given", data=np.array([c.given for c in self.choices], dtype=np.int8))
         s = f.create_group("summary")
         for key, value in self.summary.items():
             s.attrs[key] = value
@@ -154,6 +164,12 @@ class ResultsWriter:
                     c.attrs[key] = value
 
 
+def _value_text(value) -> str:
+    if isinstance(value, tuple):
+        return "[" + ", ".join(repr(v) for v in value) + "]"
+    return str(value)
+
+
 @dataclass
 class Results:
     """A results file read back into memory (arrays in the file's units; see ``units``)."""
@@ -168,6 +184,7 @@ class Results:
     summary: dict
     units: dict
     checkpoint: Optional[dict] = None
+    choices: list = None  # (key, value, reason) of every automatic choice
 
     @property
     def status(self) -> str:
@@ -198,12 +215,17 @@ def read_results(path: str | Path) -> Results:
                         checkpoint[k[:-6]] = []
                     else:
                         checkpoint[k] = _plain(v)
+            choices = []
+            if "choices" in f:
+                c = f["choices"]
+                choices = list(zip(*(( [v.decode() if isinstance(v, bytes) else str(v) for v in c[k][()]])
+                                     for k in ("key", "value", "reason"))))
             case = f["case"][()]
             return Results(path=str(path), attrs={k: _plain(v) for k, v in f.attrs.items()},
                            case_yaml=case.decode() if isinstance(case, bytes) else str(case),
                            x=f["grid/x"][()], y=f["grid/y"][()], history=history, fields=fields,
                            summary={k: _plain(v) for k, v in f["summary"].attrs.items() if k != "units"},
-                           units=units, checkpoint=checkpoint)
+                           units=units, checkpoint=checkpoint, choices=choices)
     except FileNotFoundError:
         raise ValueError(f"{path}: no such results file") from None
     except OSError as exc:

@@ -1,30 +1,32 @@
 """Automatic domain and grid: hold the final wear scar, resolve the initial Hertz contact.
 
 The element size follows the paper's convergence rule (Table 1): 40 elements
-over 7a, i.e. dx = 7a/40 with a the Hertz half-width.  The domain must hold
-the scar the run will make, which grows far beyond 2a: the worn volume per
-unit length V' = (k_m + k_s)·P'·4δ·N shared by a cylinder worn to a circular
-segment of half-width b gives V' ≈ 2b³/(3R), so b ≈ (3RV'/2)^(1/3) (for a ball,
-a cap: V ≈ πb⁴/(4R)).  The domain spans that, with a margin, plus the stroke,
-over which the flat's scar extends; the run still stops with an error if the
-pressure ever reaches the edge.
+over 7a, i.e. dx = 7a/40 with a the Hertz half-width along x; across a line
+contact the paper's 370 µm rows (27 over a 10 mm cylinder); across a point
+contact the same rule on the y half-width (square elements for a ball, as in
+the paper).  The domain must hold the scar the run will make, which grows far
+beyond 2a: the worn volume of both bodies (k_m + k_s)·P·4δ·N, held by the
+geometry's worn shape (see ``Geometry.scar_half_widths``), with a margin, plus
+the stroke along x, over which the flat's scar extends.  The run still stops
+with an error if the pressure ever reaches the edge.
 """
 from __future__ import annotations
 
 import math
 from dataclasses import dataclass
 
-from fretsim.reference import hertz_line, hertz_point
+from fretsim.geometry import Geometry
 
 ELEMENTS_OVER_7A = 40  # paper Table 1
-CYLINDER_ROWS = 27  # paper section 2.1.1: 370 µm across a 10 mm cylinder
+LINE_ROWS = 27  # paper section 2.1.1: 370 µm across a 10 mm cylinder
 SCAR_MARGIN = 1.3
 
 
 @dataclass(frozen=True)
 class Sizing:
-    hertz_half_width: float  # mm
-    scar_half_width: float  # mm, estimated
+    half_width_x: float  # Hertz a along x (mm)
+    half_width_y: float
+    scar_half_width: float  # mm, estimated, along x
     domain: tuple[float, ...]  # mm
     elements: tuple[int, ...]
     note: str
@@ -35,28 +37,29 @@ def _odd(n: float) -> int:
     return n if n % 2 else n + 1
 
 
-def auto_grid(geometry: str, dimension: str, radius: float, length: float | None, load: float, stroke: float,
-              cycles: int, k_total: float, e_star: float) -> Sizing:
-    if geometry == "cylinder_on_flat":
-        a = hertz_line(load / length, radius, e_star).half_width
-        scar = (1.5 * radius * k_total * (load / length) * 4 * stroke * cycles) ** (1 / 3)
-    else:
-        a = hertz_point(load, radius, e_star).radius
-        scar = (4 * radius * k_total * load * 4 * stroke * cycles / math.pi) ** 0.25
-    # no contact is wider than the body: beyond that the run stops at the physical limit (worn through)
-    scar = min(scar, radius)
+def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float, cycles: int, k_total: float,
+              e_star: float) -> Sizing:
+    """The paper's element size and a domain holding the estimated final scar (both bodies' volume)."""
+    h = geometry.hertz(load, e_star)
+    a = h.half_width_x
+    volume = k_total * load * 4 * stroke * cycles
+    scar_x, scar_y = geometry.scar_half_widths(volume)
+    # no contact is wider than the body: beyond that the run stops at the physical limit
+    limits = geometry.limits
+    scar_x = min(scar_x, 2 * limits.reach_x)
     dx = 7 * a / ELEMENTS_OVER_7A
-    reach = SCAR_MARGIN * max(scar, a) + stroke + 3 * dx
+    reach = SCAR_MARGIN * max(scar_x, a) + stroke + 3 * dx
     nx = _odd(2 * reach / dx)
-    if dimension == "2d":
-        return Sizing(a, scar, (nx * dx,), (nx,), f"dx = 7a/40 = {dx * 1e3:.3g} µm (a = {a * 1e3:.3g} µm), "
-                      f"x extent {nx * dx:.3g} mm for an estimated scar half-width {scar:.3g} mm")
-    if geometry == "cylinder_on_flat":
-        ny, ly = CYLINDER_ROWS, length
+    note = (f"dx = 7a/40 = {dx * 1e3:.3g} µm (a = {a * 1e3:.3g} µm), x extent {nx * dx:.3g} mm for an estimated "
+            f"scar half-width {scar_x:.3g} mm")
+    if plane_strain:
+        return Sizing(a, h.half_width_y, scar_x, (nx * dx,), (nx,), note)
+    if h.line:
+        ny, ly = LINE_ROWS, geometry.line_length
     else:
-        half = SCAR_MARGIN * max(scar, a) + 3 * dx
-        ny = _odd(2 * half / dx)
-        ly = ny * dx
-    return Sizing(a, scar, (nx * dx, ly), (nx, ny),
-                  f"dx = 7a/40 = {dx * 1e3:.3g} µm (a = {a * 1e3:.3g} µm), dy = {ly / ny * 1e3:.3g} µm, "
-                  f"domain {nx * dx:.3g} × {ly:.3g} mm for an estimated scar half-width {scar:.3g} mm")
+        scar_y = min(scar_y, 2 * (limits.reach_y or scar_y))
+        dy = 7 * h.half_width_y / ELEMENTS_OVER_7A
+        ny = _odd(2 * (SCAR_MARGIN * max(scar_y, h.half_width_y) + 3 * dy) / dy)
+        ly = ny * dy
+    return Sizing(a, h.half_width_y, scar_x, (nx * dx, ly), (nx, ny),
+                  note + f"; dy = {ly / ny * 1e3:.3g} µm, y extent {ly:.3g} mm")

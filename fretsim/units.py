@@ -36,28 +36,33 @@ def parse_quantity(value: object, dimension: str) -> float:
     """
     table = UNITS[dimension]
     shown = [u for u in table if u != "km"][:5]
-    expected = f"a number with a {dimension.replace('_', ' ')} unit ({', '.join(shown)}), e.g. '{_example(dimension)}'"
+    expected = f"a number with a {dimension.replace('_', ' ')} unit ({', '.join(shown)}), e.g. '{example(dimension)}'"
     if isinstance(value, bool) or value is None:
-        raise UnitError(f"got {value!r}; expected {expected}")
+        raise UnitError(f"got {_short(value)}; expected {expected}")
     if isinstance(value, (int, float)):
-        raise UnitError(f"got the bare number {value!r} without a unit; expected {expected}")
+        raise UnitError(f"got the bare number {_short(value)} without a unit; expected {expected}")
     if not isinstance(value, str):
         raise UnitError(f"got a {type(value).__name__}; expected {expected}")
     m = _QUANTITY.match(value)
     if not m:
-        raise UnitError(f"could not read {value!r}; expected {expected}")
+        raise UnitError(f"could not read {_short(value)}; expected {expected}")
     number, unit = float(m.group(1)), m.group(2)
     if unit not in table:
         for dim, other in UNITS.items():
             if unit in other and dim != dimension:
-                raise UnitError(f"{value!r} is a {dim.replace('_', ' ')}, not a {dimension.replace('_', ' ')}; expected {expected}")
-        raise UnitError(f"unknown unit {unit!r} in {value!r}; expected {expected}")
+                raise UnitError(f"{_short(value)} is a {dim.replace('_', ' ')}, not a {dimension.replace('_', ' ')}; expected {expected}")
+        raise UnitError(f"unknown unit {unit!r} in {_short(value)}; expected {expected}")
     if not math.isfinite(number):
-        raise UnitError(f"{value!r} is not a finite number")
+        raise UnitError(f"{_short(value)} is not a finite number")
     return number * table[unit]
 
 
-def _example(dimension: str) -> str:
+def _short(value: object) -> str:
+    text = repr(value)
+    return text if len(text) <= 40 else text[:35] + "…" + text[-4:]
+
+
+def example(dimension: str) -> str:
     return {"length": "25 um", "force": "185 N", "pressure": "200 GPa", "wear_coefficient": "2.0e-8 1/MPa"}[dimension]
 
 

@@ -15,7 +15,8 @@ import numpy as np  # noqa: E402
 
 from fretsim.case import CaseError, load_case  # noqa: E402
 from fretsim.refine import mape  # noqa: E402
-from fretsim.simulate import SimulationError, prepare, simulate, summarize  # noqa: E402
+from fretsim.plan import prepare  # noqa: E402
+from fretsim.simulate import SimulationError, simulate, summarize  # noqa: E402
 
 ROOT = Path(__file__).resolve().parent.parent
 
@@ -33,15 +34,15 @@ class Run:
 
 
 def run_case(case_file: str, overrides: list[str], label: str = "", allow_unstable: bool = False,
-             stop_on_checkerboard: bool = True) -> Run:
+             stop_on_checkerboard: bool = True, observers: tuple = ()) -> Run:
     """Run in-process (no file I/O) and time the loop alone."""
     case = load_case(ROOT / case_file, overrides)
     try:
-        setup, _ = prepare(case, allow_unstable=allow_unstable)
+        setup, _, _ = prepare(case, allow_unstable=allow_unstable)
     except CaseError as exc:  # e.g. a linear jump past the stability limit: refused is a result here
         return Run(label or " ".join(overrides), "refused", float("nan"), 0, 0, {}, None,
                    str(exc).splitlines()[-1].strip())
-    setup = dataclasses.replace(setup, stop_on_checkerboard=stop_on_checkerboard)
+    setup = dataclasses.replace(setup, watch_growth=stop_on_checkerboard)
     steps = []
 
     class Count:
@@ -57,7 +58,7 @@ def run_case(case_file: str, overrides: list[str], label: str = "", allow_unstab
 
     t = time.perf_counter()
     try:
-        simulate(setup, (Count(), Last()))
+        simulate(setup, (Count(), Last()) + tuple(observers))
         status, msg = "complete", ""
     except SimulationError as exc:
         status, msg = "failed", str(exc)

@@ -1,135 +1,187 @@
-"""Acceleration without losing accuracy: implicit steps, adaptive jumping, refinement, and stability guards."""
+"""Fewer solves without losing the state: BDF2 and backward Euler against the exact per-cycle model, stability
+where the paper's methods fail, the paper's adaptive jumping, refinement."""
 import functools
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from conftest import E_STAR, cylinder_problem
+from conftest import cylinder_problem
 from fretsim.api import run
 from fretsim.case import CaseError, load_case
-from fretsim.compliance import Compliance
-from fretsim.grid import Grid
-from fretsim.jumping import CHECKERBOARD_LIMIT, ImplicitCompliance, implicit_jump_cap
+from fretsim.plan import prepare
 from fretsim.refine import coarsen, mape, refine_pressure
-from fretsim.simulate import prepare
+from fretsim.simulate import simulate
 from fretsim.solvers import solve
+from fretsim.stability import wear_spectrum
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
-SHORT = ["model.dimension=2d", "loading.cycles=10000", "output.snapshots=[10000]"]
+SHIPPED = sorted(p.stem for p in CASES.glob("*.yaml"))
+# issue #9's targets at the defaults, at every recorded state, against the exact model on the same grid
+DEPTH, PRESSURE, P0 = 1e-3, 2e-2, 5e-3
+
+
+class States:
+    def __init__(self):
+        self.states = {}
+
+    def on_step(self, setup, step):
+        if step.is_snapshot:
+            self.states[step.cycle] = (step.wear_moving.copy(), step.wear_stationary.copy(), step.pressure.copy())
 
 
 @functools.lru_cache(maxsize=None)
-def last_step(*overrides: str):
-    out = run(load_case(CASES / "mccoll_185N.yaml", list(overrides)))
+def states_of(name: str, *overrides: str):
+    setup, _, _ = prepare(load_case(CASES / f"{name}.yaml", list(overrides)))
+    obs = States()
+    simulate(setup, (obs,))
+    return obs.states
+
+
+def worst_errors(name: str, *overrides: str, reference=("jumping.scheme=linear", "jumping.linear=1")):
+    ref, got = states_of(name, *overrides, *reference), states_of(name, *overrides)
+    depth = pressure = p0 = 0.0
+    for c, (hm_r, hs_r, p_r) in ref.items():
+        if c == 0:
+            continue
+        hm, hs, p = got[c]
+        depth = max(depth, abs(hm.max() / hm_r.max() - 1), abs(hs.max() / hs_r.max() - 1))
+        pressure = max(pressure, float(np.linalg.norm(p - p_r) / np.linalg.norm(p_r)))
+        row, col = p_r.shape[0] // 2, p_r.shape[1] // 2
+        p0 = max(p0, abs(p[row, col] / p_r[row, col] - 1))
+    return depth, pressure, p0
+
+
+@pytest.mark.parametrize("cycles", [10, 100, 2000])
+def test_default_steps_match_the_exact_per_cycle_model_at_every_recorded_state(cycles):
+    depth, pressure, p0 = worst_errors("mccoll_185N", "model.dimension=2d", f"loading.cycles={cycles}",
+                                       "output.snapshots=auto")
+    assert depth <= DEPTH and pressure <= PRESSURE and p0 <= P0, (depth, pressure, p0)
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", ["mccoll_185N", "mccoll_500N_10um"])
+def test_default_steps_match_the_exact_model_over_a_whole_case(name):
+    depth, pressure, p0 = worst_errors(name, "model.dimension=2d")
+    assert depth <= DEPTH and pressure <= PRESSURE and p0 <= P0, (depth, pressure, p0)
+
+
+def test_bdf2_is_more_accurate_than_backward_euler_at_a_third_of_the_tolerance_with_half_the_solves():
+    # BDF2's order is verified on polynomials in test_jumping.py; in the loop, the contact front's
+    # non-smoothness and the landing on recorded states blur a fixed-step order study, so the claim that
+    # matters is compared directly: accuracy per solve against the exact model (measured: 47 vs 163 solves)
+    base = ("model.dimension=2d", "loading.cycles=2000", "output.snapshots=auto")
+    solves = {}
+    errors = {}
+    for scheme, tol in (("bdf2", 0.01), ("implicit", 0.01 / 3)):
+        overrides = (*base, f"jumping.scheme={scheme}", f"jumping.tolerance={tol}")
+        solves[scheme] = run(load_case(CASES / "mccoll_185N.yaml", list(overrides))).summary["contact_solves"]
+        errors[scheme] = worst_errors("mccoll_185N", *overrides)
+    assert all(b <= e for b, e in zip(errors["bdf2"], errors["implicit"])), errors
+    assert solves["bdf2"] < 0.5 * solves["implicit"], solves
+
+
+@pytest.mark.parametrize("body", ["moving", "stationary"])
+@pytest.mark.parametrize("name", SHIPPED)
+def test_either_body_with_a_zero_wear_coefficient_completes_with_the_default_scheme(name, body):
+    out = run(load_case(CASES / f"{name}.yaml", ["model.dimension=2d", f"materials.{body}.wear_coefficient=0 1/MPa"]))
     assert out.status == "complete", out.message
-    return out
-
-
-def reference(*grid):
-    """No-jump stand-in: explicit steps of 5 cycles (ΔN 5 and 1 differ by < 1e-5 in depth, measured)."""
-    return last_step(*SHORT, "jumping.scheme=linear", "jumping.linear=5", *grid)
-
-
-def rel(a, b):
-    return abs(a / b - 1)
-
-
-# --- the implicit step -----------------------------------------------------------------------------------------
-
-def test_implicit_compliance_is_positive_definite_for_any_jump_when_the_flat_does_not_wear():
-    grid = Grid.centred(40, 3, 0.00628, 10 / 3)
-    base = Compliance(grid, E_STAR)
-    lam0 = np.linalg.eigvalsh(base.dense()).min()
-    for cycles in (1e2, 1e5, 1e8):
-        lam = np.linalg.eigvalsh(ImplicitCompliance(base, cycles, 0.025, 2e-8, 0.0).dense()).min()
-        assert lam >= lam0 * (1 - 1e-9)  # C + s·k_m·I: the wear term only adds
-    assert implicit_jump_cap(grid, E_STAR, 0.025, 2e-8, 0.0) == np.inf
-
-
-def test_implicit_compliance_with_only_the_flat_wearing_is_positive_definite_up_to_the_cap_only():
-    # k_m = 0: the stroke average B has negative Fourier modes, so C + s·k_s·B loses definiteness for long jumps
-    grid = Grid.centred(120, 1, 0.00628, 1.0, plane_strain=True)
-    base = Compliance(grid, E_STAR)
-    cap = implicit_jump_cap(grid, E_STAR, 0.025, 0.0, 3e-8)
-    assert np.isfinite(cap)
-    n = grid.size
-    q = np.linalg.qr(np.column_stack([np.ones(n), np.eye(n)[:, :n - 1]]))[0][:, 1:]  # the load fixes the mean
-
-    def lam(cycles):
-        return np.linalg.eigvalsh(q.T @ ImplicitCompliance(base, cycles, 0.025, 0.0, 3e-8).dense() @ q).min()
-    assert lam(cap) > 0
-    assert lam(8 * cap) < 0  # the cap is not vacuous: twice its safety margin, squared, and definiteness is gone
-
-
-def test_implicit_step_is_first_order_accurate():
-    ref = reference()
-    errors = []
-    for jump in (1000, 500, 250):  # fixed steps: no control (tolerance at its ceiling), jump bounded both ways
-        out = last_step(*SHORT, "jumping.scheme=implicit", f"jumping.linear={jump}", f"jumping.max={jump}",
-                        "jumping.tolerance=0.5")
-        errors.append(rel(out.summary["centre_wear_depth_stationary_um"], ref.summary["centre_wear_depth_stationary_um"]))
-    ratios = np.array(errors[:-1]) / np.array(errors[1:])
-    assert ((ratios > 1.6) & (ratios < 2.6)).all(), (errors, ratios)  # halving the step halves the error
-
-
-def test_default_implicit_run_matches_the_reference_in_depth_and_pressure():
-    ref, out = reference(), last_step(*SHORT)
-    assert out.setup.scheme == "implicit"
-    assert rel(out.summary["centre_wear_depth_stationary_um"], ref.summary["centre_wear_depth_stationary_um"]) < 1e-3
-    assert mape(ref.last.pressure, out.last.pressure) < 3.0  # % over the contact; edges dominate it
-    assert out.summary["contact_solves"] < ref.summary["contact_solves"] / 20
     assert out.summary["archard_volume_error"] < 1e-9
+    # the paper's gap model is kept wherever it is stable on the grid, and replaced (with the reason) where not:
+    # without wear of the moving body it is unstable whenever the stroke average has negative modes on the grid
+    paper = wear_spectrum(out.setup.compliance, out.setup.stroke, out.setup.k_moving, out.setup.k_stationary,
+                          "mid_stroke")
+    assert out.setup.gap_model == ("stroke_average" if paper.growth_rate > 0 else "mid_stroke")
+    if body == "moving" and out.setup.stroke > 1.5 * out.setup.grid.dx:
+        assert out.setup.gap_model == "stroke_average"
 
 
-def test_3d_default_is_within_1pct_of_the_reference():
-    ref = last_step("loading.cycles=18000", "jumping.scheme=linear", "jumping.linear=10")
-    out = last_step("loading.cycles=18000")
-    assert rel(out.summary["centre_wear_depth_stationary_um"], ref.summary["centre_wear_depth_stationary_um"]) < 0.01
+def test_the_papers_gap_model_forced_where_it_is_unstable_is_refused_with_advice_that_runs():
+    overrides = ["model.dimension=2d", "materials.moving.wear_coefficient=0 1/MPa", "model.gap=mid_stroke"]
+    with pytest.raises(CaseError, match="model.gap: auto") as info:
+        prepare(load_case(CASES / "mccoll_185N.yaml", overrides))
+    assert "unstable" in str(info.value)
+    advice = [o for o in overrides if not o.startswith("model.gap")] + ["model.gap=auto"]
+    assert run(load_case(CASES / "mccoll_185N.yaml", advice)).status == "complete"
 
 
-# --- the paper's adaptive jumping --------------------------------------------------------------------------------
-
-def test_paper_preset_on_the_papers_coarse_grid_reproduces_the_no_jump_run():
-    grid = ("grid.coarse_element=[15.75 um]",)
-    ref = reference(*grid)
-    out = last_step(*SHORT, "jumping.preset=paper", *grid)
-    total = out.last.wear_moving + out.last.wear_stationary
-    ref_total = ref.last.wear_moving + ref.last.wear_stationary
-    assert mape(ref_total, total) < 1.0  # % total wear depth, the DOE's measure (scripts/study_doe.py)
-    assert mape(ref.last.pressure, out.last.pressure) < 2.0
-    assert out.summary["archard_volume_error"] < 1e-9  # the Taylor extrapolation conserves volume
-    assert out.summary["contact_solves"] < ref.summary["contact_solves"] / 10
+@pytest.mark.parametrize("fraction", [0.5, 0.9, 0.99])
+@pytest.mark.parametrize("name", SHIPPED)
+def test_linear_jumps_below_the_computed_limit_complete(name, fraction):
+    # up to 4000 cycles here (an instability shows within a few hundred steps); whole cases in the slow suite
+    case = load_case(CASES / f"{name}.yaml", ["model.dimension=2d", "loading.cycles=4000", "output.snapshots=auto"])
+    limit = prepare(case)[0].stability_limit
+    jump = max(1, int(fraction * limit))
+    out = run(load_case(CASES / f"{name}.yaml", ["model.dimension=2d", "loading.cycles=4000", "output.snapshots=auto",
+                                                "jumping.scheme=linear", f"jumping.linear={jump}"]))
+    assert out.status == "complete", out.message
 
 
-def test_adaptive_jumps_on_a_fine_grid_never_end_silently_unstable(tmp_path):
-    out = run(load_case(CASES / "mccoll_185N.yaml", [*SHORT, "jumping.preset=paper", "jumping.linear=20"]),
-              tmp_path / "a.h5")
-    if out.status == "complete":
-        from fretsim.results import read_results
-        assert read_results(tmp_path / "a.h5").history["checkerboard_amplitude"].max() < CHECKERBOARD_LIMIT
-    else:
-        assert "checkerboard" in out.message and "implicit" in out.message
+@pytest.mark.slow
+@pytest.mark.parametrize("fraction", [0.5, 0.9, 0.99])
+@pytest.mark.parametrize("name", SHIPPED)
+def test_linear_jumps_below_the_computed_limit_complete_whole_cases(name, fraction):
+    limit = prepare(load_case(CASES / f"{name}.yaml", ["model.dimension=2d"]))[0].stability_limit
+    out = run(load_case(CASES / f"{name}.yaml", ["model.dimension=2d", "jumping.scheme=linear",
+                                                f"jumping.linear={max(1, int(fraction * limit))}"]))
+    assert out.status == "complete", out.message
 
 
-# --- stability guards ----------------------------------------------------------------------------------------------
-
-def test_linear_jump_beyond_the_limit_is_refused_with_the_computed_limit():
+def test_a_linear_jump_above_the_limit_is_refused_and_the_advised_jump_runs():
+    case = ["model.dimension=2d", "loading.cycles=3000"]
+    limit = prepare(load_case(CASES / "mccoll_185N.yaml", case))[0].stability_limit
     with pytest.raises(CaseError) as info:
-        prepare(load_case(CASES / "mccoll_185N.yaml", ["jumping.linear=80"]))
-    assert "stability limit 42." in str(info.value) and "jumping.linear" in str(info.value)
+        prepare(load_case(CASES / "mccoll_185N.yaml", [*case, f"jumping.linear={int(1.2 * limit)}"]))
+    text = str(info.value)
+    assert f"stability limit {limit:.4g}" in text
+    advised = int(text.split("Use at most ")[1].split()[0])
+    assert run(load_case(CASES / "mccoll_185N.yaml", [*case, f"jumping.linear={advised}"])).status == "complete"
 
 
-def test_linear_jump_near_the_limit_is_caught_when_the_pressure_checkerboards():
-    out = run(load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", "jumping.linear=42"]))
-    assert out.status == "failed" and "checkerboards" in out.message
+def test_an_unstable_linear_jump_forced_through_is_caught_by_its_growth():
+    case = load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", "loading.cycles=20000"])
+    limit = prepare(case)[0].stability_limit
+    setup, _, _ = prepare(load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", "loading.cycles=20000",
+                                                                  "jumping.scheme=linear",
+                                                                  f"jumping.linear={int(1.2 * limit)}"]),
+                          allow_unstable=True)
+    from fretsim.simulate import NumericalFailure
+    with pytest.raises(NumericalFailure, match="checkerboards") as info:
+        simulate(setup)
+    assert info.value.cycle < 20000
+
+
+@pytest.mark.parametrize("jumping", [["jumping.scheme=adaptive"], ["jumping.preset=paper"],
+                                     ["jumping.scheme=adaptive", "jumping.linear=10"]], ids=["defaults", "preset",
+                                                                                             "linear-10"])
+@pytest.mark.parametrize("name", ["mccoll_185N", "mccoll_1670N", "kirk_450N_20Hz"])
+def test_the_papers_adaptive_jumping_completes_on_the_default_grid(name, jumping):
+    cycles = ["loading.cycles=30000"] if name.startswith("kirk") else []
+    out = run(load_case(CASES / f"{name}.yaml", ["model.dimension=2d", *cycles, *jumping]))
+    assert out.status == "complete", out.message
+    assert out.summary["archard_volume_error"] < 1e-9  # the Taylor extrapolation conserves volume
+
+
+def test_paper_preset_is_scaled_to_the_grids_limit_and_says_so():
+    out = run(load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", "jumping.preset=paper"]))
+    choice = next(c for c in out.plan.choices if c.key == "jumping.linear")
+    assert out.setup.linear_jump < 55 < out.setup.stability_limit * 2 and "exceeds this grid's" in choice.reason
 
 
 def test_solves_grow_logarithmically_with_cycles():
-    counts = [last_step("model.dimension=2d", f"loading.cycles={n}", f"output.snapshots=[{n}]").summary[
-        "contact_solves"] for n in (2000, 20000, 200000)]
+    counts = [run(load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", f"loading.cycles={n}",
+                                                         f"output.snapshots=[{n}]"])).summary["contact_solves"]
+              for n in (2000, 20000, 200000)]
     steps = np.diff(counts)
     assert steps[1] <= 1.3 * steps[0], counts  # the same few dozen solves per decade of cycles
+
+
+def test_results_carry_the_runs_error_estimates(tmp_path):
+    from fretsim.results import read_results
+    run(load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", "loading.cycles=2000"]), tmp_path / "r.h5")
+    res = read_results(tmp_path / "r.h5")
+    assert 0 < res.summary["error_estimate_depth"] < 0.1 and 0 < res.summary["error_estimate_pressure"] < 0.1
+    assert res.history["error_estimate_pressure"].shape == res.history["cycle"].shape
 
 
 # --- refinement (Eqs. 11-12) -----------------------------------------------------------------------------------------
@@ -147,7 +199,9 @@ def test_refinement_keeps_load_and_wear_volume_and_meets_the_papers_10pct_mape()
 
 
 def test_refined_run_agrees_with_the_fine_run():
-    fine = last_step(*SHORT)
-    coarse = last_step(*SHORT, "grid.coarse_element=[15.75 um]")
-    assert rel(coarse.summary["centre_wear_depth_stationary_um"], fine.summary["centre_wear_depth_stationary_um"]) < 0.01
+    base = ("model.dimension=2d", "loading.cycles=10000", "output.snapshots=[10000]")
+    fine = run(load_case(CASES / "mccoll_185N.yaml", list(base)))
+    coarse = run(load_case(CASES / "mccoll_185N.yaml", [*base, "grid.coarse_element=[15.75 um]"]))
+    assert coarse.summary["centre_wear_depth_stationary_um"] == pytest.approx(
+        fine.summary["centre_wear_depth_stationary_um"], rel=0.01)
     assert abs(coarse.summary["scar_width_stationary_mm"] - fine.summary["scar_width_stationary_mm"]) < 0.03

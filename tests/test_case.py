@@ -26,7 +26,7 @@ def problems_of(text, overrides=None):
 
 def test_the_issue_example_case_parses_into_internal_units():
     c = parse_case(CONTRACT)
-    assert (c.radius, c.length, c.normal_load, c.stroke, c.cycles) == (6.0, 10.0, 185.0, 0.025, 18000)
+    assert (c.geometry.radius, c.geometry.length, c.normal_load, c.stroke, c.cycles) == (6.0, 10.0, 185.0, 0.025, 18000)
     assert c.moving.youngs_modulus == 2.0e5 and c.stationary.wear_coefficient == 3.0e-8
     assert (c.dimension, c.solver, c.linear_jump, c.snapshots) == ("3d", "cg", 55, (1000, 5000, 10000, 18000))
 

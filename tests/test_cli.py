@@ -63,8 +63,8 @@ def test_existing_results_are_not_overwritten(cli, tmp_path):
 
 def test_failed_run_exits_3_and_marks_the_file(cli, tmp_path):
     r = cli.invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), "-o", "f.h5", "--set", "model.dimension=2d",
-                          "--set", "jumping.linear=40"])
-    assert r.exit_code == 3 and "checkerboard" in r.output
+                          "--set", "grid.domain=[0.35 mm]", "--set", "grid.elements=[57]"])
+    assert r.exit_code == 3 and "edge of the grid" in r.output
     assert json.loads(cli.invoke(main, ["summary", "f.h5", "--json"]).output)["status"] == "failed"
 
 

@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from fretsim.compliance import Compliance, love_rectangle, strip_plane_strain
+from fretsim.compliance import HalfSpace, love_rectangle, strip_plane_strain
 from fretsim.grid import Grid
 
 ROUND_OFF = 1e-12  # FFT vs direct summation: both exact up to floating point
@@ -29,7 +29,7 @@ def test_plane_strain_strip_gradient_matches_line_load_far_away():
 @pytest.mark.parametrize("grid", [Grid.centred(9, 6, 0.1, 0.3), Grid.centred(11, 1, 0.1, 1.0, plane_strain=True)],
                          ids=["3d", "2d"])
 def test_fft_operator_equals_dense_symmetric_matrix(grid):
-    op = Compliance(grid, 1.1e5)
+    op = HalfSpace(grid, 1.1e5)
     dense = op.dense()
     p = np.random.default_rng(0).random(grid.shape)
     assert np.abs(dense - dense.T).max() <= ROUND_OFF * np.abs(dense).max()
@@ -37,10 +37,69 @@ def test_fft_operator_equals_dense_symmetric_matrix(grid):
 
 
 def test_3d_compliance_is_positive_definite():
-    dense = Compliance(Grid.centred(12, 8, 0.01, 0.4), 1.1e5).dense()
+    dense = HalfSpace(Grid.centred(12, 8, 0.01, 0.4), 1.1e5).dense()
     assert np.linalg.eigvalsh(dense).min() > 0
 
 
 def test_dense_refused_beyond_limit():
     with pytest.raises(ValueError, match="dense compliance"):
-        Compliance(Grid.centred(100, 100, 0.01, 0.01), 1.1e5).dense()
+        HalfSpace(Grid.centred(100, 100, 0.01, 0.01), 1.1e5).dense()
+
+
+# --- the operator family: one interface, sums, windows ----------------------------------------------------------
+
+from fretsim.compliance import Convolution, Matrix, Sum, add, scaled  # noqa: E402
+from fretsim.compliance import fft as fft_module  # noqa: E402
+from fretsim.wear import wear_operator  # noqa: E402
+
+
+def _dense_apply(op, p):
+    return (op.dense() @ p.ravel()).reshape(p.shape)
+
+
+@pytest.mark.parametrize("grid", [Grid.centred(13, 7, 0.01, 0.3), Grid.centred(15, 1, 0.01, 1.0, plane_strain=True)],
+                         ids=["3d", "2d"])
+def test_sum_of_half_space_wear_term_and_a_matrix_applies_as_the_sum_of_their_matrices(grid):
+    rng = np.random.default_rng(1)
+    hs = HalfSpace(grid, 1.1e5)
+    w = wear_operator(grid, 0.025, 2e-8, 3e-8, "mid_stroke")
+    m = Matrix(grid, np.diag(rng.random(grid.size)) * 1e-6)
+    op = Sum(hs, scaled(w, 300.0), m)
+    assert op.convolution is not None and len(op.others) == 1  # the two convolutions merged: one FFT pair
+    p = rng.random(grid.shape)
+    expected = _dense_apply(hs, p) + 300.0 * _dense_apply(w, p) + _dense_apply(m, p)
+    assert np.abs(op(p) - expected).max() <= ROUND_OFF * np.abs(expected).max()
+    assert np.abs(op.dense() - (hs.dense() + 300.0 * w.dense() + m.dense())).max() <= ROUND_OFF * np.abs(op.dense()).max()
+
+
+def test_a_window_of_any_operator_is_the_sub_block_of_its_matrix():
+    grid = Grid.centred(17, 9, 0.01, 0.2)
+    rng = np.random.default_rng(2)
+    ops = [HalfSpace(grid, 1.1e5), add(HalfSpace(grid, 1.1e5), scaled(wear_operator(grid, 0.02, 1e-8, 2e-8,
+                                                                                     "stroke_average"), 50.0)),
+           Sum(HalfSpace(grid, 1.1e5), Matrix(grid, rng.random((grid.size, grid.size)) * 1e-7))]
+    rows, cols = slice(2, 7), slice(3, 12)
+    idx = np.arange(grid.size).reshape(grid.shape)[rows, cols].ravel()
+    for op in ops:
+        sub = op.window(rows, cols)
+        assert sub.grid.shape == (5, 9) and np.allclose(sub.grid.x, grid.x[cols]) and np.allclose(sub.grid.y, grid.y[rows])
+        full = op.dense()[np.ix_(idx, idx)]
+        assert np.abs(sub.dense() - full).max() <= ROUND_OFF * np.abs(full).max()
+        p = rng.random(sub.grid.shape)
+        assert np.abs(sub(p).ravel() - full @ p.ravel()).max() <= 1e-12 * np.abs(full @ p.ravel()).max()
+
+
+def test_windows_of_one_shape_share_one_symbol_wherever_they_lie():
+    op = HalfSpace(Grid.centred(40, 5, 0.01, 0.2), 1.1e5)
+    a, b = op.window(slice(0, 5), slice(0, 10)), op.window(slice(0, 5), slice(25, 35))
+    assert a.hat is b.hat  # translation invariance: the window's operator depends on its size only
+
+
+def test_direct_fft_path_equals_the_public_scipy_api():
+    rng = np.random.default_rng(3)
+    for shape, p in (((14, 40), rng.random((7, 19))), ((1, 64), rng.random((1, 30)))):
+        direct = fft_module.forward(p, shape)
+        public = fft_module._public_forward(p, shape)
+        assert np.abs(direct - public).max() <= ROUND_OFF * np.abs(public).max()
+        back = fft_module.backward(direct, shape, p.shape)
+        assert np.abs(back - fft_module._public_backward(public, shape, p.shape)).max() <= ROUND_OFF

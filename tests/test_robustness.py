@@ -117,7 +117,8 @@ def _check_rejected(tmp_path, text, sections):
     assert r.output.startswith("fretsim: ") and "Traceback" not in r.output, r.output
     assert str(case) in r.output or "line" in r.output  # names the file
     if sections is not None:  # names the YAML path of (at least) one of the problems
-        assert any(f"- {s}" in r.output for s in sections) or "- grid" in r.output, r.output
+        named = [f"- {s}" for s in sections + ("grid",)] + [f": {s}" for s in sections + ("grid",)]
+        assert any(n in r.output for n in named), r.output
     assert not out.exists()
 
 

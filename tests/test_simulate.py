@@ -78,16 +78,11 @@ def test_3d_wear_exceeds_the_centre_line_near_the_cylinder_ends():
     assert s["max_wear_depth_stationary_um"] > s["centre_wear_depth_stationary_um"]  # end effect (Fig. 5)
 
 
-def test_checkerboarding_linear_jump_is_detected_and_stops_the_run(tmp_path):
-    case = load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", "jumping.linear=40"])  # limit 42.7
-    out = run(case, tmp_path / "r.h5")
-    assert out.status == "failed" and "checkerboard" in out.message and "stability limit" in out.message
-    assert read_results(tmp_path / "r.h5").status == "failed"
-
-
-def test_a_stable_jump_above_half_the_limit_is_not_flagged():
-    s = summary_of("mccoll_185N", "2d", "jumping.linear=30")  # limit 42.7: stable, non-monotone modes decay
-    assert s["cycles"] == 18000
+def test_linear_jumps_just_below_the_limit_are_not_false_alarms():
+    # issue #9: jumps of 38-42 cycles (limit 42.7) used to stop with a checkerboard alarm; their modes decay
+    for jump in (38, 42):
+        s = summary_of("mccoll_185N", "2d", f"jumping.linear={jump}")
+        assert s["cycles"] == 18000
 
 
 def test_contact_outgrowing_the_grid_stops_with_an_edge_error():

@@ -67,3 +67,52 @@ def _positive(**values: float) -> None:
     for name, v in values.items():
         if not (v > 0 and math.isfinite(v)):
             raise ValueError(f"{name} must be positive and finite, got {v}")
+
+
+@dataclass(frozen=True)
+class HertzElliptical:
+    """Two bodies of relative principal radii Rx (along x) and Ry (along y) under load P (Johnson §4.2).
+
+    The contact is an ellipse with semi-axes ``ax`` along x and ``ay`` along y; p = p0 √(1 − x²/ax² − y²/ay²).
+    """
+
+    ax: float  # mm
+    ay: float  # mm
+    peak_pressure: float  # MPa
+    approach: float  # mm
+
+    def pressure(self, x: np.ndarray, y: np.ndarray) -> np.ndarray:
+        r2 = (np.asarray(x, float) / self.ax) ** 2 + (np.asarray(y, float) / self.ay) ** 2
+        return self.peak_pressure * np.sqrt(np.clip(1.0 - r2, 0.0, None))
+
+
+def hertz_elliptical(load: float, radius_x: float, radius_y: float, e_star: float) -> HertzElliptical:
+    """Hertz's elliptical contact for the gap x²/(2Rx) + y²/(2Ry).
+
+    With semi-axes a ≥ b (a along the direction of smaller curvature), e² = 1 − b²/a², and K, E the complete
+    elliptic integrals of modulus e:  B/A = ((a²/b²)E − K)/(K − E) fixes e,  A = 3P(K − E)/(2πE* e² a³)
+    fixes a,  P = (2/3)πab·p0 and the approach δ = p0·b·K/E*.
+    """
+    from scipy.optimize import brentq
+    from scipy.special import ellipe, ellipk
+
+    _positive(load=load, radius_x=radius_x, radius_y=radius_y, e_star=e_star)
+    curv_x, curv_y = 1.0 / (2.0 * radius_x), 1.0 / (2.0 * radius_y)
+    small, big = min(curv_x, curv_y), max(curv_x, curv_y)
+    if big / small - 1.0 < 1e-9:  # a circle: the ball formulas with the mean radius
+        h = hertz_point(load, 2.0 / (curv_x + curv_y) / 2.0, e_star)
+        return HertzElliptical(h.radius, h.radius, h.peak_pressure, h.approach)
+
+    def mismatch(m: float) -> float:  # m = e²
+        k_, e_ = ellipk(m), ellipe(m)
+        return (e_ / (1.0 - m) - k_) / (k_ - e_) - big / small
+
+    m = brentq(mismatch, 1e-10, 1.0 - 1e-15, xtol=1e-16, rtol=1e-15, maxiter=500)
+    k_, e_ = ellipk(m), ellipe(m)
+    a = (3.0 * load * (k_ - e_) / (2.0 * math.pi * e_star * m * small)) ** (1.0 / 3.0)
+    b = math.sqrt(1.0 - m) * a
+    p0 = 3.0 * load / (2.0 * math.pi * a * b)
+    approach = p0 * b * k_ / e_star
+    # the major axis a lies along the direction of the smaller curvature
+    ax, ay = (a, b) if curv_x <= curv_y else (b, a)
+    return HertzElliptical(ax, ay, p0, approach)

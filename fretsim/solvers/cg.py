@@ -1,9 +1,20 @@
-"""Constrained conjugate gradient of Polonsky & Keer (Wear 231, 1999) with FFT convolution.
+"""Constrained conjugate gradient of Polonsky & Keer (Wear 231, 1999), preconditioned, with FFT convolution.
 
-Minimises the complementary energy ½pᵀCp + pᵀg over p ≥ 0 with Σp·A = W.
-Each iteration costs one FFT convolution while the contact set is unchanged, two when it changes.  A warm start (the previous
-pressure) cuts the iterations when the gap changes a little between solves,
-as it does between wear steps.
+Minimises the complementary energy ½pᵀCp + pᵀg over p ≥ 0 with Σp·A = W.  Each iteration costs one
+application of C while the contact set is unchanged (the displacement is updated, not recomputed), and one
+of the preconditioner.
+
+Preconditioner: the inverse of the translation-invariant part's Fourier symbol on the padded grid (the
+operator's ``convolution``), applied to the residual on the contact set and projected back onto zero-mean
+changes.  It approximates C⁻¹ inside the contact, whatever the element aspect ratio (a finite cylinder's
+elements are ~60 times longer than wide), and includes an implicit step's wear term exactly.  It halves the
+iterations and makes each ~4 times more accurate (measured, scripts/bench_contact.py); a Polonsky–Keer step
+is the unpreconditioned special case.
+
+Convergence needs both: the pressure changed by less than ``tol`` (relative, L1) in the last iteration, and
+the gap is complementary — no element outside the contact set penetrates by more than PENETRATION of the
+displacement scale.  A start on one element, whose residual is zero, is therefore never "converged" while
+its neighbours penetrate.
 """
 from __future__ import annotations
 
@@ -11,17 +22,29 @@ from typing import Optional
 
 import numpy as np
 
-from fretsim.compliance import Compliance
 from fretsim.solvers.result import ContactResult, complementarity_residual
 
+PENETRATION = 1e-6  # allowed penetration outside the contact set, relative to the displacement scale
+RECOMPUTE_EVERY = 20  # the incrementally updated displacement is recomputed this often (round-off)
 
-def solve_cg(compliance: Compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] = None,
-             tol: float = 1e-10, max_iter: Optional[int] = None) -> ContactResult:
+
+def _preconditioner(compliance):
+    conv = getattr(compliance, "convolution", None)
+    if conv is None:
+        return None
+    hat = conv.hat.real if np.iscomplexobj(conv.hat) else conv.hat
+    inv = 1.0 / np.maximum(hat, 1e-3 * float(hat.max()))
+    return lambda v: conv.backward(conv.forward(v) * inv)
+
+
+def solve_cg(compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] = None,
+             tol: float = 1e-10, max_iter: Optional[int] = None, precondition: bool = True) -> ContactResult:
     area = compliance.grid.area
     total = load / area  # required Σp
     allowed = np.isfinite(gap)
     h = np.where(allowed, gap, 0.0)
     max_iter = max_iter or max(1000, 5 * int(np.sqrt(gap.size)) + 200)
+    precond = _preconditioner(compliance) if precondition else None
 
     if p0 is not None and (p0[allowed] > 0).any():
         p = np.where(allowed, np.clip(p0, 0.0, None), 0.0)
@@ -33,40 +56,55 @@ def solve_cg(compliance: Compliance, gap: np.ndarray, load: float, p0: Optional[
     p *= total / p.sum()
 
     t = np.zeros_like(p)
-    g_norm_old = 1.0
+    gz_old = 1.0
     delta = 0.0
     err = np.inf
     u = compliance(p)
+    complementary = False
     for it in range(1, max_iter + 1):
-        g = u + h
         on = p > 0
-        g -= g[on].mean()
-        g_norm = float(np.dot(g[on], g[on]))
-        t = np.where(on, g + delta * (g_norm / g_norm_old) * t, 0.0)
-        g_norm_old = g_norm
+        m = on.astype(float)
+        count = float(m.sum())
+        g = u + h
+        g -= float((g * m).sum()) / count
+        if precond is not None:
+            z = precond(g * m) * m
+            z -= m * (float(z.sum()) / count)
+        else:
+            z = g * m
+        gz = float((g * z).sum())
+        t = z + (delta * gz / gz_old) * t if delta else z
+        t *= m
+        gz_old = gz
         r_raw = compliance(t)
-        r = r_raw - r_raw[on].mean()
-        denom = float(np.dot(r[on], t[on]))
-        if denom == 0.0 or g_norm == 0.0:
-            err = 0.0
-            break
-        tau = float(np.dot(g[on], t[on])) / denom
+        r_mean = float((r_raw * m).sum()) / count
+        denom = float((r_raw * t).sum()) - r_mean * float(t.sum())
+        penetrating = (~on) & allowed & (g < 0.0)
+        if denom <= 0.0 or gz == 0.0:
+            # nothing left to do on this set: converged if nothing outside it penetrates
+            if not penetrating.any():
+                err, complementary = 0.0, True
+                break
+            p[penetrating] = -g[penetrating] * (total / max(float(np.abs(g[penetrating]).sum()), 1e-300))
+            p *= total / p.sum()
+            u, delta = compliance(p), 0.0
+            continue
+        tau = float((g * t).sum()) / denom
         p_old = p
         trial = p - tau * t
         clipped = bool((trial < 0.0).any())
         p = np.clip(trial, 0.0, None)
-        overlap = (p == 0.0) & (g < 0.0) & allowed
-        if overlap.any():
+        if penetrating.any():
             delta = 0.0
-            p[overlap] -= tau * g[overlap]
+            p[penetrating] -= tau * g[penetrating]
         else:
             delta = 1.0
         scale = total / p.sum()
         p *= scale
         # Without clipping or added elements p is linear in t, and so is u: one FFT per iteration instead of
         # two.  Otherwise (an element may be clipped and re-added in one step, leaving the set unchanged but p
-        # not linear in t), and every 20th step against round-off, u is recomputed exactly.
-        if clipped or delta == 0.0 or it % 20 == 0:
+        # not linear in t), and every RECOMPUTE_EVERY-th step against round-off, u is recomputed exactly.
+        if clipped or delta == 0.0 or it % RECOMPUTE_EVERY == 0:
             u = compliance(p)
         else:
             u = scale * (u - tau * r_raw)
@@ -74,13 +112,28 @@ def solve_cg(compliance: Compliance, gap: np.ndarray, load: float, p0: Optional[
         if not np.isfinite(err):
             return ContactResult(p_old, 0.0, p_old > 0, it, False, f"cg: non-finite pressure at iteration {it}")
         if err < tol:
-            break
+            complementary = _complementary(u, h, p, allowed)
+            if complementary:
+                break
     u = compliance(p)
     on = p > 0
     approach = float((u + h)[on].mean())
-    contact = on
     residual = complementarity_residual(u, np.where(allowed, gap, np.inf), p, approach)
-    success = err < tol
-    msg = (f"cg converged in {it} iterations (relative pressure change {err:.1e} < {tol:.0e})" if success else
-           f"cg did not converge in {it} iterations: relative pressure change {err:.1e} > tolerance {tol:.0e}")
-    return ContactResult(p, approach, contact, it, success, msg, residual)
+    success = err < tol and complementary
+    msg = (f"cg converged in {it} iterations (relative pressure change {err:.1e} < {tol:.0e}, gap complementary)"
+           if success else
+           f"cg did not converge in {it} iterations: relative pressure change {err:.1e} (tolerance {tol:.0e})"
+           + ("" if complementary or err >= tol else ", elements outside the contact penetrate"))
+    return ContactResult(p, approach, on, it, success, msg, residual)
+
+
+def _complementary(u: np.ndarray, h: np.ndarray, p: np.ndarray, allowed: np.ndarray) -> bool:
+    """No element outside the contact set penetrates beyond PENETRATION of the displacement scale."""
+    on = p > 0
+    g = u + h
+    alpha = float(g[on].mean())
+    outside = (~on) & allowed
+    if not outside.any():
+        return True
+    scale = max(float(np.abs(u[on]).max()), 1e-300)
+    return bool(float((g[outside] - alpha).min()) >= -PENETRATION * scale)

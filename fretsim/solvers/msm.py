@@ -35,11 +35,10 @@ from typing import Optional
 import numpy as np
 import scipy.linalg as sla
 
-from fretsim.compliance import Compliance
 from fretsim.solvers.result import ContactResult, complementarity_residual
 
 
-def solve_msm(compliance: Compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] = None,
+def solve_msm(compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] = None,
               tol: float = 1e-10, max_iter: Optional[int] = None) -> ContactResult:
     shape = gap.shape
     idx = np.flatnonzero(np.isfinite(gap).ravel())

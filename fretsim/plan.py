@@ -1,0 +1,359 @@
+"""The plan of a run: every automatic decision, each a small function returning its value and its reason.
+
+:func:`prepare` turns a validated :class:`~fretsim.case.Case` into the loop's :class:`~fretsim.simulate.Setup`
+(arrays, numbers, operators) and a *filled* case in which every automatic choice is written out, so the run
+can be repeated — or resumed — exactly.  The list of :class:`Choice` is stored in the results file
+(``/choices``) and printed by ``fretsim check``; choices the case made itself are listed too, as "given".
+"""
+from __future__ import annotations
+
+import math
+import os
+from dataclasses import dataclass, field
+from typing import Any, Optional
+
+import numpy as np
+
+from fretsim.case import PRESETS, Case, CaseError
+from fretsim.compliance import HalfSpace
+from fretsim.grid import Grid
+from fretsim.reference import effective_modulus
+from fretsim.simulate import Setup
+from fretsim.sizing import Sizing, auto_grid
+from fretsim.stability import Spectrum, default_linear_jump, wear_spectrum
+from fretsim.wear import stroke_reach, stroke_symbol, wear_operator
+
+MAX_STROKE_OVER_CONTACT = 50.0  # δ/a beyond this is sliding, not fretting, or a unit slip (µm → mm)
+MEMORY_SHARE = 0.5  # refuse a grid that would take more than this share of the machine's memory
+MODEL_GROWTH = math.log(1e3)  # a forced unstable model may grow a seed at most 1000-fold over the run
+SHORT_RUN = 8  # runs of at most this many cycles are taken a cycle at a time: exact, and as cheap
+MIN_ELEMENTS_ACROSS_CONTACT = 4
+
+
+@dataclass(frozen=True)
+class Choice:
+    """One decision of the plan: the case key it fills, its value (as written in the filled case) and why."""
+
+    key: str
+    value: Any
+    reason: str
+    given: bool = False  # True when the case set it itself
+
+
+@dataclass
+class Plan:
+    choices: list = field(default_factory=list)
+    warnings: list = field(default_factory=list)
+
+    def add(self, choice: Choice) -> Any:
+        self.choices.append(choice)
+        return choice.value
+
+
+def available_memory() -> int:
+    """Physical memory of this machine in bytes."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (ValueError, OSError, AttributeError):
+        return 8 * 2**30
+
+
+def memory_estimate(elements: int, snapshots: int, solver: str, coarse_elements: int = 0) -> float:
+    """Bytes a run needs: ~40 work arrays, FFT buffers (4x, complex), 4 fields per snapshot, the implicit
+    schemes' history (3 arrays × 8 points), a dense matrix for the dense solvers (on the grid solved on)."""
+    from fretsim.solvers import DENSE_SOLVERS
+    solved = coarse_elements or elements
+    need = 8.0 * elements * (40 + 24 + 4 * snapshots) + 8.0 * solved * 4 * 2 * 4
+    if solver in DENSE_SOLVERS:
+        need += 3 * 8.0 * solved**2  # the matrix, its gathered copy, the basis factors
+    return need
+
+
+# --- the choices ----------------------------------------------------------------------------------------------
+
+def choose_dimension(case: Case, e_star: float) -> Choice:
+    """2d or 3d.  auto: the cheapest whose centre line is within model.accuracy of the full 3D model.
+
+    The estimate is the share of P/L the 3D centre line carries at the start (one contact solve on the 3D
+    grid): end effects take the rest, most at the start (wear evens them out), and the centre-line wear
+    follows that share.  Point contacts have no 2D model.
+    """
+    g = case.geometry
+    if case.dimension != "auto":
+        return Choice("model.dimension", case.dimension, "given in the case", True)
+    if not g.has_2d:
+        return Choice("model.dimension", "3d", f"a {g.kind} is a point contact: it has no 2D model")
+    share = centre_line_share(case, e_star)
+    off = abs(1.0 - share)
+    if off <= case.accuracy:
+        return Choice("model.dimension", "2d", f"the 3D centre line carries {share:.2%} of P/L at the start, "
+                                               f"{off:.2%} from 2D, within model.accuracy {case.accuracy:.2%}: 2D "
+                                               f"(end effects, which 2D leaves out, are small)")
+    return Choice("model.dimension", "3d", f"the 3D centre line carries {share:.2%} of P/L at the start (end "
+                                           f"effects take the rest): 2D would be {off:.2%} off, more than "
+                                           f"model.accuracy {case.accuracy:.2%}")
+
+
+def centre_line_share(case: Case, e_star: float) -> float:
+    """Share of the line load P/L the centre line of the unworn 3D contact carries (one solve)."""
+    from fretsim.simulate import centre_line
+    from fretsim.solvers import solve
+    g = case.geometry
+    sizing = auto_grid(g, False, case.normal_load, case.stroke, 0, 0.0, e_star)
+    nx, ny = sizing.elements
+    grid = Grid.centred(nx, ny, sizing.domain[0] / nx, sizing.domain[1] / ny)
+    res = solve(HalfSpace(grid, e_star), g.separation(grid), case.normal_load, tol=1e-8)
+    return float(centre_line(res.pressure).sum() * grid.dx / (case.normal_load / g.line_length))
+
+
+def choose_grid(case: Case, plane: bool, sizing: Sizing) -> tuple[Choice, Choice]:
+    given_d, given_e = case.domain is not None, case.elements is not None
+    if given_d and given_e:
+        return (Choice("grid.domain", case.domain, "given in the case", True),
+                Choice("grid.elements", case.elements, "given in the case", True))
+    if not given_d and not given_e:
+        return (Choice("grid.domain", sizing.domain, "automatic: holds the estimated final scar: " + sizing.note),
+                Choice("grid.elements", sizing.elements, "automatic: the paper's convergence rule, dx = 7a/40"))
+    if given_d:
+        dx = sizing.domain[0] / sizing.elements[0]
+        elements = tuple(max(1, int(round(d / dx))) | 1 for d in case.domain[:1]) + (
+            (sizing.elements[1],) if not plane else ())
+        return (Choice("grid.domain", case.domain, "given in the case", True),
+                Choice("grid.elements", elements, f"the 7a/40 rule ({dx * 1e3:.3g} µm) over the given domain"))
+    return (Choice("grid.domain", sizing.domain, "automatic, for the given elements: " + sizing.note),
+            Choice("grid.elements", case.elements, "given in the case", True))
+
+
+def choose_gap_model(case: Case, grid: Grid) -> Choice:
+    """mid_stroke (the paper) where it is stable, stroke_average where the paper's model itself is not."""
+    k_m, k_s = case.moving.wear_coefficient, case.stationary.wear_coefficient
+    b_min = float(stroke_symbol(grid.dx, case.stroke, np.linspace(0.01 * np.pi, np.pi, 400)).min())
+    stable = k_m + k_s * min(b_min, 0.0) >= 0
+    if case.gap_model != "auto":
+        return Choice("model.gap", case.gap_model, "given in the case", True)
+    if stable:
+        return Choice("model.gap", "mid_stroke", "the paper's model (Eq. 18): stable here, since k_m ≥ "
+                                                 f"{-min(b_min, 0):.3f}·k_s")
+    return Choice("model.gap", "stroke_average",
+                  f"the paper's mid-stroke gap is unstable when the moving body wears less than "
+                  f"{-b_min:.3f} of the flat (k_m = {k_m:.3g}, k_s = {k_s:.3g} 1/MPa): wear modes shorter than "
+                  f"the stroke grow in the model itself and break the pressure into spikes; the flat's wear seen "
+                  f"through the stroke average is stable and equal to first order")
+
+
+def choose_scheme(case: Case) -> Choice:
+    if case.preset is not None:
+        return Choice("jumping.scheme", case.scheme, f"preset {case.preset}: the paper's adaptive jumping", True)
+    given = any(k.startswith("jumping.scheme=") for k in case.overrides)
+    if case.cycles <= SHORT_RUN and case.scheme == "bdf2" and not given:
+        return Choice("jumping.scheme", "linear", f"{case.cycles} cycles: taken one cycle at a time, which is the "
+                                                  f"model itself and no dearer than steps")
+    reasons = {"bdf2": f"second-order implicit steps under error control (tolerance {case.step_tolerance:g}): no "
+                       f"stability limit, recorded states landed on with shrinking steps",
+               "implicit": "backward-Euler steps (first order) under error control",
+               "linear": "the paper's explicit linear jumps", "adaptive": "the paper's adaptive jumps (Eqs. 19-21)"}
+    return Choice("jumping.scheme", case.scheme, reasons[case.scheme])
+
+
+def choose_linear_jump(case: Case, scheme: str, limit: float, grid: Grid) -> Choice:
+    if scheme in ("bdf2", "implicit"):
+        return Choice("jumping.linear", default_linear_jump(limit, case.cycles),
+                      "not used by implicit steps; half the explicit stability limit, for reference")
+    if case.cycles <= SHORT_RUN and scheme == "linear" and case.linear_jump is None:
+        return Choice("jumping.linear", 1, "one cycle per step: the model's own per-cycle update")
+    if case.linear_jump is not None:
+        return Choice("jumping.linear", case.linear_jump, "given in the case", True)
+    half = default_linear_jump(limit, case.cycles)
+    if case.preset is not None:
+        paper = PRESETS[case.preset]["linear"]
+        if paper <= half:
+            return Choice("jumping.linear", paper, f"preset {case.preset}: the paper's ΔN_L = {paper}")
+        return Choice("jumping.linear", half, f"preset {case.preset}: the paper's ΔN_L = {paper} exceeds this "
+                                              f"grid's explicit stability limit {limit:.4g} cycles (elements "
+                                              f"{grid.dx * 1e3:.3g} µm; the paper's were coarser): scaled to half "
+                                              f"the limit, {half}")
+    return Choice("jumping.linear", half, f"half the explicit stability limit {limit:.4g} cycles: every mode "
+                                          f"decays without changing sign")
+
+
+def choose_snapshots(case: Case) -> Choice:
+    if case.snapshots is not None:
+        return Choice("output.snapshots", case.snapshots, "given in the case", True)
+    n = case.cycles
+    return Choice("output.snapshots", tuple(sorted({0, n // 4, n // 2, 3 * n // 4, n})),
+                  "automatic: 0, N/4, N/2, 3N/4 and N")
+
+
+# --- prepare ----------------------------------------------------------------------------------------------------
+
+def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan]:
+    """Unpack a case into arrays and numbers; fill the automatic choices into the returned case.
+
+    A linear jump beyond the explicit stability limit is refused (CaseError) unless ``allow_unstable``
+    (for studies of the instability itself); so is the paper's gap model where it is unstable over the run.
+    """
+    plan = Plan()
+    g = case.geometry
+    e_star = effective_modulus(case.moving.youngs_modulus, case.moving.poissons_ratio,
+                               case.stationary.youngs_modulus, case.stationary.poissons_ratio)
+    k_m, k_s = case.moving.wear_coefficient, case.stationary.wear_coefficient
+    problems: list = []
+    hertz = g.hertz(case.normal_load, e_star)
+    if case.stroke > MAX_STROKE_OVER_CONTACT * hertz.half_width_x:
+        problems.append(("loading.stroke", f"the stroke amplitude {case.stroke:.4g} mm is "
+                                           f"{case.stroke / hertz.half_width_x:.0f} times the Hertz contact "
+                                           f"half-width ({hertz.half_width_x:.3g} mm); fretting is a small "
+                                           f"oscillation (up to {MAX_STROKE_OVER_CONTACT:g} a here): check its unit"))
+    if problems:
+        raise CaseError(case.source, problems)
+    dimension = plan.add(choose_dimension(case, e_star))
+    plane = dimension == "2d"
+    sizing = auto_grid(g, plane, case.normal_load, case.stroke, case.cycles, k_m + k_s, e_star)
+    c_domain, c_elements = choose_grid(case, plane, sizing)
+    domain, elements = plan.add(c_domain), plan.add(c_elements)
+    if len(domain) < (1 if plane else 2) or len(elements) < (1 if plane else 2):
+        problems.append(("grid", "a 3d case needs two entries in grid.domain and grid.elements: [x, y]"))
+        raise CaseError(case.source, problems)
+    nx = elements[0]
+    ny = 1 if plane else elements[1]
+    snapshots = plan.add(choose_snapshots(case))
+    coarse_n = 0
+    if case.coarse_element is not None:
+        if len(case.coarse_element) < (1 if plane else 2):
+            problems.append(("grid.coarse_element", "a 3d case needs two entries: [dx, dy]"))
+            raise CaseError(case.source, problems)
+        cnx = max(3, int(round(domain[0] / case.coarse_element[0])))
+        cny = 1 if plane else max(1, int(round(domain[1] / case.coarse_element[1])))
+        coarse_n = cnx * cny
+    need = memory_estimate(nx * ny, len(snapshots) + 5, case.solver, coarse_n)
+    if need > MEMORY_SHARE * available_memory():
+        problems.append(("grid", f"the grid of {nx} x {ny} elements{' (automatic)' if case.elements is None else ''}"
+                                 f"{f' solved on {coarse_n} coarse elements' if coarse_n else ''} with solver "
+                                 f"{case.solver} would need about {need / 2**30:.1f} GiB, more than "
+                                 f"{MEMORY_SHARE:.0%} of this machine's {available_memory() / 2**30:.0f} GiB; "
+                                 f"coarsen the grid, shorten the run, or check the case's units"))
+    if problems:
+        raise CaseError(case.source, problems)
+    dy = 1.0 if plane else domain[1] / ny
+    grid = Grid.centred(nx, ny, domain[0] / nx, dy, plane_strain=plane)
+    if case.stroke >= domain[0] / 2:
+        problems.append(("loading.stroke", f"the stroke amplitude {case.stroke:.4g} mm is larger than half the "
+                                           f"grid's x extent ({domain[0]:.4g} mm): check its unit"))
+    if g.line_length is not None and not plane and domain[1] < g.line_length * (1 - 1e-9):
+        problems.append(("grid.domain", f"the y extent {domain[1]:.4g} mm is shorter than the contact length "
+                                        f"({g.line_length:.4g} mm): the contact would be cut off"))
+    reach = stroke_reach(grid.dx, case.stroke)
+    if nx <= 2 * reach + 4:
+        problems.append(("grid.elements", f"{nx} elements along x leave no room for the stroke "
+                                          f"({reach} elements each side)"))
+    if problems:
+        raise CaseError(case.source, problems)
+
+    gap_model = plan.add(choose_gap_model(case, grid))
+    coarse = coarse_gap = coarse_op = None
+    if case.coarse_element is not None:
+        coarse = Grid.centred(cnx, cny, domain[0] / cnx, 1.0 if plane else domain[1] / cny, plane_strain=plane)
+        coarse_gap = g.separation(coarse)
+        coarse_op = HalfSpace(coarse, e_star)
+        plan.add(Choice("grid.coarse_element", case.coarse_element, f"given: contact solved on {cnx} x {cny} "
+                                                                    f"elements, pressure refined to {nx} x {ny} "
+                                                                    f"(Akima weights, Eqs. 11-12)", True))
+    compliance = HalfSpace(grid, e_star)
+    solve_op = coarse_op if coarse_op is not None else compliance
+    spectrum = wear_spectrum(solve_op, case.stroke, k_m, k_s, gap_model)
+    limit = spectrum.limit
+    _check_model_growth(case, gap_model, spectrum, plan)
+    scheme = plan.add(choose_scheme(case))
+    jump = plan.add(choose_linear_jump(case, scheme, limit, solve_op.grid))
+    if scheme in ("linear", "adaptive") and jump > limit and not allow_unstable:
+        raise CaseError(case.source, [("jumping.linear", f"{jump} cycles exceeds the explicit stability limit "
+                                      f"{limit:.4g} cycles of this grid (element {solve_op.grid.dx * 1e3:.3g} µm, "
+                                      f"stroke {case.stroke * 1e3:.3g} µm): the pressure would checkerboard. Use at "
+                                      f"most {max(1, int(limit))} (default: {default_linear_jump(limit, case.cycles)}"
+                                      f"), or jumping.scheme: bdf2, which has no such limit")])
+    if scheme in ("linear", "adaptive") and jump > 0.5 * limit:
+        plan.warnings.append(f"jumping.linear = {jump} lies between half the explicit stability limit and the "
+                             f"limit ({limit:.4g} cycles): stable, but wear modes oscillate while they decay")
+    max_jump = case.max_jump
+    if scheme == "adaptive" and max_jump is None:
+        max_jump = plan.add(Choice("jumping.max", 600, "the paper's ΔN_max"))
+    plan.add(Choice("solver.method", case.solver, "given in the case" if case.solver != "cg" else
+                    "cg: FFT-based constrained conjugate gradient, O(n log n) per iteration", case.solver != "cg"))
+    cap = 0.5 / spectrum.growth_rate if spectrum.growth_rate > 0 else float("inf")
+    per_cycle = limit > 1.0
+    if scheme in ("bdf2", "implicit") and not per_cycle:
+        plan.warnings.append(f"the paper's per-cycle update is itself unstable on this grid (explicit limit "
+                             f"{limit:.3g} cycles < 1): the implicit steps follow the continuous wear ODE instead; "
+                             f"check the wear coefficients, or coarsen the grid")
+    beyond = [s for s in snapshots if s > case.cycles]
+    if beyond:
+        plan.warnings.append(f"snapshots {list(beyond)} lie beyond the run's {case.cycles} cycles and are skipped")
+    snapshots = tuple(sorted({s for s in snapshots if s <= case.cycles} | {case.cycles}))
+    warn_gross_slip(case, e_star, hertz, plan)
+    load = case.normal_load / g.line_length if plane else case.normal_load
+    setup = Setup(grid=grid, compliance=compliance, gap=g.separation(grid), load=load, total_load=case.normal_load,
+                  k_moving=k_m, k_stationary=k_s, stroke=case.stroke, cycles=case.cycles, gap_model=gap_model,
+                  scheme=scheme, linear_jump=jump, stability_limit=limit, method=case.solver,
+                  tolerance=case.tolerance, snapshots=snapshots,
+                  volume_factor=g.line_length if plane else 1.0, limits=g.limits, y_edges_free=g.y_edges_free,
+                  eta=case.eta, max_jump=max_jump, step_tolerance=case.step_tolerance, implicit_cap=cap,
+                  wear_op=wear_operator(solve_op.grid, case.stroke, k_m, k_s, gap_model), coarse=coarse,
+                  coarse_compliance=coarse_op, coarse_gap=coarse_gap, per_cycle=per_cycle,
+                  notes=tuple(f"{c.key} = {_show(c.value)}: {c.reason}" for c in plan.choices if not c.given)
+                  + tuple(plan.warnings))
+    filled = case.with_choices(dimension=dimension, domain=tuple(domain[:1] if plane else domain[:2]),
+                               elements=(nx,) if plane else (nx, ny), gap_model=gap_model, scheme=scheme,
+                               linear_jump=jump, max_jump=max_jump, snapshots=snapshots)
+    return setup, filled, plan
+
+
+def _check_model_growth(case: Case, gap_model: str, spectrum: Spectrum, plan: Plan) -> None:
+    """The paper's gap model forced where it is unstable: refused if its spurious modes grow over the run."""
+    rate = spectrum.growth_rate
+    if rate <= 0:
+        return
+    growth = rate * case.cycles
+    if growth > MODEL_GROWTH:
+        raise CaseError(case.source, [("model.gap", f"the paper's mid-stroke gap is unstable for these wear "
+                                                    f"coefficients (the moving body wears too little): its "
+                                                    f"fastest wear mode grows {rate:.3g}-fold per cycle, "
+                                                    f"e^{growth:.0f} over the run. Use model.gap: auto (or "
+                                                    f"stroke_average), which is stable")])
+    plan.warnings.append(f"the mid-stroke gap model is unstable here (growth rate {rate:.3g} per cycle), but "
+                         f"over {case.cycles} cycles a seed grows at most e^{growth:.1f}-fold")
+
+
+def warn_gross_slip(case: Case, e_star: float, hertz, plan: Plan) -> None:
+    """With a friction coefficient: is the stroke beyond the partial-slip limit (gross slip)?
+
+    Point contact (Mindlin; Johnson §7.2): sliding starts at δ* = 3μP/(16 a)·Σ(2 − ν)/G (a for a ball; √(ax·ay)
+    for an ellipse, an estimate).  Line contact: a half-plane has no finite tangential compliance; with a tangential
+    line load Q' = μP' its surface moves u = (2/(πE*))·Q'·ln(d/x) relative to a datum at depth d (Johnson eq.
+    2.19b, both bodies in E*), so with the datum at the radius δ* ≈ (2μP'/(πE*))·ln(2R/a), an estimate.  Below δ*
+    the contact partly sticks and the gross-slip Archard model overestimates the wear.
+    """
+    mu = case.friction_coefficient
+    if mu is None:
+        return
+    if hertz.line:
+        radius = 2 * case.geometry.limits.reach_x
+        limit = 2 * mu * case.normal_load / case.geometry.line_length / (math.pi * e_star) * math.log(
+            2 * radius / hertz.half_width_x)
+    else:
+        inv_g = sum((2 - m.poissons_ratio) * 2 * (1 + m.poissons_ratio) / m.youngs_modulus
+                    for m in (case.moving, case.stationary))
+        limit = 3 * mu * case.normal_load * inv_g / (16 * math.sqrt(hertz.half_width_x * hertz.half_width_y))
+    if case.stroke <= limit:
+        plan.warnings.append(f"the stroke {case.stroke * 1e3:.3g} µm is within the partial-slip limit "
+                             f"{limit * 1e3:.3g} µm for μ = {mu:g}: the contact partly sticks, and the gross-slip "
+                             f"Archard model (this tool's) does not apply; its wear is an overestimate")
+    else:
+        plan.choices.append(Choice("loading.friction_coefficient", mu, f"gross slip: the stroke is "
+                                                                       f"{case.stroke / limit:.1f}× the partial-slip "
+                                                                       f"limit {limit * 1e3:.3g} µm", True))
+
+
+def _show(value: Any) -> str:
+    if isinstance(value, tuple):
+        return "[" + ", ".join(f"{v:.4g}" if isinstance(v, float) else str(v) for v in value) + "]"
+    return f"{value:.4g}" if isinstance(value, float) else str(value)

@@ -1,0 +1,162 @@
+"""Stability of the explicit wear update, for the operator actually used, and a detector that measures growth.
+
+Explicit (forward-Euler) wear updates h ← h + ΔN·W p, with p the contact
+pressure for the current gap.  Linearised about a settled contact, a wear
+perturbation changes the pressure by δp = −C⁻¹δh (the load fixes its mean), so
+each eigenmode of the pencil (W, C) is multiplied per step by 1 − ΔN·μ.  The
+update is stable for ΔN < 2/μ_max; μ is largest for the shortest wave the grid
+holds, where the compliance c is smallest (c ∝ element size / E*), so the
+limit shrinks with the element size, the wear coefficients and the stroke and
+grows with 1/E*.  Below half the limit every mode decays without changing sign.
+A negative μ means the *model* is unstable (see :mod:`fretsim.wear`).
+
+Two ways to get μ: the closed form over the Fourier symbols (a plain half-space
+and a translation-invariant W, the fast path) and, for any operator, the
+generalised eigenvalues of (W, C) on a window of the grid around its centre
+(the finite section approaches the lattice from inside; tests check both agree).
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import lru_cache
+
+import numpy as np
+import scipy.linalg as sla
+
+from fretsim.compliance import HalfSpace
+from fretsim.wear import stroke_symbol, wear_operator
+
+SAFETY = 0.5  # default jump as a fraction of the limit: monotone decay of every mode
+WINDOW = (9, 48)  # rows, columns of the window for the general method
+
+
+@dataclass(frozen=True)
+class Spectrum:
+    """Extreme eigenvalues μ (per cycle) of the explicit wear update's pencil (W, C)."""
+
+    mu_min: float
+    mu_max: float
+    method: str  # "symbol" (closed form) or "window" (dense generalised eigenvalues)
+
+    @property
+    def limit(self) -> float:
+        """Largest stable explicit jump ΔN (cycles)."""
+        return float("inf") if self.mu_max <= 0 else 2.0 / self.mu_max
+
+    @property
+    def growth_rate(self) -> float:
+        """Per-cycle growth of the fastest growing wear mode of the model itself (0 if none grows)."""
+        return max(0.0, -self.mu_min)
+
+
+@lru_cache(maxsize=32)
+def _halfspace_symbol(plane_strain: bool, dx: float, dy: float, ny: int, e_star: float, theta: tuple) -> np.ndarray:
+    from fretsim.grid import Grid
+    grid = Grid.centred(3, ny, dx, dy, plane_strain=plane_strain)
+    # the 2D log kernel's sums converge as 1/lags, the 3D ones as 1/lags²
+    return HalfSpace(grid, e_star).symbol_x(np.array(theta), lags=4096 if plane_strain else 512)
+
+
+THETA = tuple(np.linspace(0.01 * np.pi, np.pi, 160))
+
+
+def wear_spectrum(compliance, stroke: float, k_moving: float, k_stationary: float, gap_model: str,
+                  general: bool = False) -> Spectrum:
+    """μ_min and μ_max of the explicit update for ``compliance`` (closed form for a plain half-space)."""
+    grid = compliance.grid
+    if isinstance(compliance, HalfSpace) and not general:
+        theta = np.array(THETA)
+        f = _halfspace_symbol(grid.plane_strain, grid.dx, grid.dy, grid.shape[0], compliance.e_star, THETA)
+        b = stroke_symbol(grid.dx, stroke, theta)
+        rate = 4.0 * stroke * (k_moving + k_stationary * (b if gap_model == "mid_stroke" else b * b))
+        mu = rate / f
+        return Spectrum(float(min(mu.min(), 0.0)), float(mu.max()), "symbol")
+    ny, nx = grid.shape
+    my, mx = min(ny, WINDOW[0]), min(nx, WINDOW[1])
+    rows = slice((ny - my) // 2, (ny - my) // 2 + my)
+    cols = slice((nx - mx) // 2, (nx - mx) // 2 + mx)
+    c = compliance.restrict(rows, cols).dense()
+    w = wear_operator(grid, stroke, k_moving, k_stationary, gap_model).restrict(rows, cols).dense()
+    n = c.shape[0]
+    # the load fixes the mean pressure: modes live in the zero-sum subspace
+    q = np.linalg.qr(np.column_stack([np.ones(n), np.eye(n)[:, :n - 1]]))[0][:, 1:]
+    mu = sla.eigh(q.T @ w @ q, q.T @ c @ q, eigvals_only=True)
+    return Spectrum(float(min(mu.min(), 0.0)), float(mu.max()), "window")
+
+
+def default_linear_jump(limit: float, cycles: int) -> int:
+    """The default ΔN_L: half the stability limit, at least 1 and at most the run."""
+    if not np.isfinite(limit):
+        return max(cycles, 1)
+    return int(max(1, min(cycles if cycles > 0 else 1, np.floor(SAFETY * limit))))
+
+
+# --- the odd-even (checkerboard) pattern of an unstable explicit update --------------------------------------
+
+NOISE_FLOOR = 1e-2  # odd-even amplitude / mean pressure below which growth is not judged (edges crossing elements)
+CEILING = 0.3  # an amplitude this large is a broken pressure field whatever its history
+GROWTH_STEPS = 8  # consecutive steps of accelerating growth that make an instability
+GROWTH_FACTOR = 1.5  # ... over which the amplitude grew at least this much
+
+
+def checkerboard_signed(pressure: np.ndarray, edge: int = 3) -> float:
+    """Signed amplitude of the odd-even component of the pressure along x, relative to its mean.
+
+    For p_i = P_i + A(−1)^i with P smooth, r_i = (−1)^i (p_{i−1} − 2p_i + p_{i+1})/4 ≈ −A at every element,
+    while the smooth part and isolated features such as edge peaks give r of no consistent sign, which
+    averages out.  The contact is taken where p exceeds 5 % of the row's peak, and elements within ``edge``
+    of its edges are left out.  Returns the row of largest magnitude (at least 6 interior elements); its
+    sign alternates from step to step when the mode oscillates.
+    """
+    p = np.atleast_2d(pressure)
+    peak = p.max(axis=1, keepdims=True)
+    on = p > 0.05 * peak
+    # a span, not the mask: a strong checkerboard has near-zero elements inside the contact
+    idx = np.arange(p.shape[1])
+    first = np.argmax(on, axis=1)[:, None]
+    last = (p.shape[1] - 1 - np.argmax(on[:, ::-1], axis=1))[:, None]
+    interior = (idx >= first + edge + 1) & (idx <= last - edge - 1) & on.any(axis=1, keepdims=True)
+    d2 = np.zeros_like(p)
+    d2[:, 1:-1] = p[:, :-2] - 2 * p[:, 1:-1] + p[:, 2:]
+    r = d2 * (1.0 - 2.0 * (idx % 2)) / 4.0
+    count = interior.sum(axis=1)
+    rows = count >= 6
+    if not rows.any():
+        return 0.0
+    mean_r = (r * interior).sum(axis=1)[rows] / count[rows]
+    mean_p = (p * interior).sum(axis=1)[rows] / count[rows]
+    amp = -mean_r / mean_p
+    return float(amp[np.argmax(np.abs(amp))])
+
+
+def checkerboard_amplitude(pressure: np.ndarray) -> float:
+    return abs(checkerboard_signed(pressure))
+
+
+class GrowthWatch:
+    """Tells a growing odd-even oscillation from a decaying (or saturating) one.
+
+    An unstable mode is multiplied by the same factor |g| > 1 every step, a_n = |g|·a_{n−1} + e_n, so its
+    growth accelerates: each increment is larger than the one before.  A stable mode (|g| < 1) excited at
+    every step (contact edges moving) rises towards a plateau e/(1 − |g|) with shrinking increments — which
+    for |g| near 1 may take dozens of steps, so "it grew" alone is not evidence.  Unstable means: above the
+    noise floor, with GROWTH_STEPS increments in a row each positive and larger than the last, or above the
+    ceiling.  A contact edge crossing an element makes a transient of a few steps; eight accelerating steps
+    and a 1.5-fold growth are not made that way.  The state is a short list of numbers, kept in the checkpoint.
+    """
+
+    def __init__(self, history=()):
+        self.history = [float(a) for a in history][-(GROWTH_STEPS + 2):]
+
+    def update(self, signed_amplitude: float) -> bool:
+        self.history = (self.history + [float(signed_amplitude)])[-(GROWTH_STEPS + 2):]
+        a = np.abs(self.history)
+        if a[-1] > CEILING:
+            return True
+        if len(a) < GROWTH_STEPS + 2 or a[-1] < NOISE_FLOOR:
+            return False
+        steps = np.diff(a)
+        return bool((steps > 0).all() and (np.diff(steps) > 0).all() and a[-1] >= GROWTH_FACTOR * a[0])
+
+    def reset(self) -> None:
+        self.history = []
