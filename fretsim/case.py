@@ -41,6 +41,7 @@ class Key:
     plausible: Optional[tuple] = None  # (lo, hi, text) in internal units: outside is refused as implausible
     choices: tuple = ()
     positive: bool = True  # quantities: must be > 0 (else ≥ 0)
+    example: str = ""  # a value for templates (`fretsim init`) where there is no default
 
     def unit(self) -> str:
         from fretsim.units import INTERNAL
@@ -49,13 +50,14 @@ class Key:
 
 GEOMETRY_KEYS: dict[str, dict[str, Key]] = {
     "cylinder_on_flat": {
-        "radius": Key("length", "cylinder radius R (Eq. 9)", REQUIRED, plausible=LENGTH_RANGE),
+        "radius": Key("length", "cylinder radius R (Eq. 9)", REQUIRED, plausible=LENGTH_RANGE, example="6 mm"),
         "length": Key("length", "cylinder length L along y (the line contact's length)", REQUIRED,
-                      plausible=LENGTH_RANGE)},
+                      plausible=LENGTH_RANGE, example="10 mm")},
     "ball_on_flat": {
-        "radius": Key("length", "ball radius R (Eq. 10)", REQUIRED, plausible=LENGTH_RANGE)},
+        "radius": Key("length", "ball radius R (Eq. 10)", REQUIRED, plausible=LENGTH_RANGE, example="6 mm")},
     "crossed_cylinders": {
-        "radius": Key("length", "radius R₁ of the moving cylinder", REQUIRED, plausible=LENGTH_RANGE),
+        "radius": Key("length", "radius R₁ of the moving cylinder", REQUIRED, plausible=LENGTH_RANGE,
+                      example="0.225 mm"),
         "radius_stationary": Key("length", "radius R₂ of the stationary cylinder (default: R₁)", None,
                                  plausible=LENGTH_RANGE),
         "sliding": Key("choice", "the moving cylinder slides across its axis or along it", "across",
@@ -65,16 +67,19 @@ GEOMETRY_KEYS: dict[str, dict[str, Key]] = {
 SCHEMA: dict[str, dict[str, Key]] = {
     "geometry": {"type": Key("choice", "the contact geometry", REQUIRED, choices=tuple(GEOMETRY_KEYS))},
     "material": {  # each of materials.moving and materials.stationary
-        "youngs_modulus": Key("pressure", "Young's modulus E", REQUIRED, plausible=(1.0, 1e7, "1 MPa to 10 TPa")),
-        "poissons_ratio": Key("number", "Poisson's ratio ν", REQUIRED, lo=-1.0, hi=0.5),
+        "youngs_modulus": Key("pressure", "Young's modulus E", REQUIRED, plausible=(1.0, 1e7, "1 MPa to 10 TPa"),
+                              example="200 GPa"),
+        "poissons_ratio": Key("number", "Poisson's ratio ν", REQUIRED, lo=-1.0, hi=0.5, example="0.3"),
         "wear_coefficient": Key("wear_coefficient", "Archard wear coefficient k (Eqs. 14–16; includes hardness)",
-                                REQUIRED, plausible=(0.0, 1e-3, "0 to 1e-3 1/MPa"), positive=False)},
+                                REQUIRED, plausible=(0.0, 1e-3, "0 to 1e-3 1/MPa"), positive=False,
+                                example="2.0e-8 1/MPa")},
     "loading": {
         "normal_load": Key("force", "normal load P (total, both in 2D and 3D)", REQUIRED,
-                           plausible=(1e-6, 1e7, "1 µN to 10 MN")),
+                           plausible=(1e-6, 1e7, "1 µN to 10 MN"), example="185 N"),
         "stroke": Key("length", "slip amplitude δ (sliding distance 4δ per cycle)", REQUIRED,
-                      plausible=(1e-6, 10.0, "1 nm to 10 mm")),
-        "cycles": Key("integer", "fretting cycles N (0 solves the contact alone)", REQUIRED, lo=0, hi=MAX_CYCLES),
+                      plausible=(1e-6, 10.0, "1 nm to 10 mm"), example="25 um"),
+        "cycles": Key("integer", "fretting cycles N (0 solves the contact alone)", REQUIRED, lo=0, hi=MAX_CYCLES,
+                      example="18000"),
         "friction_coefficient": Key("number", "friction coefficient μ: checks gross slip against Mindlin's "
                                               "partial-slip limit (not used in the wear law)", None, lo=0.0,
                                     hi=10.0)},

@@ -1,11 +1,13 @@
-"""`fretsim` command line: run, summary, plot.  No algorithm here: it wraps :mod:`fretsim.api`.
+"""`fretsim` command line.  No algorithm here: it wraps :mod:`fretsim.api`.
 
 Exit codes: 0 complete, 2 bad input (case, options, files), 3 a run that failed numerically or outgrew its grid,
-4 a run stopped at a physical limit (a body worn through), 130 interrupted (resume with --resume).
+4 a run stopped at a physical limit (a body worn through), 5 the results could not be written (disk full, I/O
+error; resume once there is room), 130 interrupted (resume with --resume).
+
+Each command imports what it needs when it runs, so `--help`, `summary` and `check` start quickly.
 """
 from __future__ import annotations
 
-import json
 import sys
 import traceback
 from pathlib import Path
@@ -15,6 +17,7 @@ import click
 EXIT_BAD_INPUT = 2
 EXIT_FAILED = 3
 EXIT_STOPPED = 4
+EXIT_IO = 5
 EXIT_INTERRUPTED = 130
 
 
@@ -28,21 +31,25 @@ def _fail(message: str, code: int, debug: bool) -> None:
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
 @click.version_option(package_name="fretsim")
 def main() -> None:
-    """Fretting-wear simulation after Kong, Bennett & Hyde: YAML case → HDF5 results → PNG plots."""
+    """Fretting-wear simulation after Kong, Bennett & Hyde: YAML case → HDF5 results → figures.
+
+    Shell completion (bash): eval "$(_FRETSIM_COMPLETE=bash_source fretsim)"
+    """
 
 
 @main.command()
-@click.argument("case_file", required=False, type=click.Path(dir_okay=False, path_type=Path))
-@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+@click.argument("case_file", required=False, type=click.Path(path_type=Path))
+@click.option("-o", "--output", type=click.Path(path_type=Path),
               help="Results file (default: CASE_FILE's name with .h5, in the current directory).")
 @click.option("--set", "overrides", multiple=True, metavar="KEY.PATH=VALUE",
               help="Override a case value, e.g. --set loading.cycles=1000 (repeatable).")
 @click.option("--overwrite", is_flag=True, help="Replace an existing results file.")
-@click.option("--resume", "resume_file", type=click.Path(dir_okay=False, path_type=Path),
+@click.option("--resume", "resume_file", type=click.Path(path_type=Path),
               help="Continue an interrupted run from its results file (no CASE_FILE then).")
+@click.option("--quiet", is_flag=True, help="No notes, no progress bar; the summary paragraph only.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
 def run(case_file: Path | None, output: Path | None, overrides: tuple, overwrite: bool, resume_file: Path | None,
-        debug: bool) -> None:
+        quiet: bool, debug: bool) -> None:
     """Run CASE_FILE and write an HDF5 results file (or --resume one)."""
     import signal
 
@@ -54,50 +61,105 @@ def run(case_file: Path | None, output: Path | None, overrides: tuple, overwrite
     if resume_file is None and case_file is None:
         _fail("give a CASE_FILE to run, or --resume RESULTS_FILE", EXIT_BAD_INPUT, debug)
     output = resume_file or output or Path(case_file.stem + ".h5")
+    progress = _Progress(quiet or not sys.stderr.isatty())
 
     def _terminate(signum, frame):  # SIGTERM ends a run as cleanly as Ctrl-C
         raise KeyboardInterrupt
 
+    def _on_plan(setup, filled, plan):
+        if not quiet:
+            for note in setup.notes:
+                click.echo(f"note: {note}", err=True)
+        progress.start(setup)
+
     previous_handler = signal.signal(signal.SIGTERM, _terminate)
+    outcome = None
     try:
         if resume_file is not None:
-            total, start = None, 0
+            outcome = resume_run(resume_file, progress=progress.update)
         else:
             case = load_case(case_file, list(overrides))
-            total, start = case.cycles, 0
-        bar = None
-        if sys.stderr.isatty() and total:
-            bar = click.progressbar(length=total, label="fretsim", file=sys.stderr, show_eta=True)
-            bar.__enter__()
-            bar.update(start)
-        try:
-            if resume_file is not None:
-                outcome = resume_run(resume_file, progress=bar.update if bar else None)
-            else:
-                outcome = run_case(case, output, overwrite=overwrite, progress=bar.update if bar else None)
-        finally:
-            if bar is not None:
-                bar.__exit__(None, None, None)
+            outcome = run_case(case, output, overwrite=overwrite, progress=progress.update, on_plan=_on_plan)
     except CaseError as exc:
-        _fail(str(exc), EXIT_BAD_INPUT, debug)
-    except ValueError as exc:  # an unreadable results file for --resume
+        progress.stop()
         _fail(str(exc), EXIT_BAD_INPUT, debug)
     except KeyboardInterrupt:
+        progress.stop()
         _fail(f"interrupted; every accepted step so far is in {output} (status 'interrupted'); continue with "
               f"`fretsim run --resume {output}`", EXIT_INTERRUPTED, debug)
     except OSError as exc:
-        _fail(f"cannot write {output}: {exc}", EXIT_BAD_INPUT, debug)
+        progress.stop()
+        _fail(f"cannot write {output}: {exc.strerror or exc}", EXIT_BAD_INPUT, debug)
     finally:
-        signal.signal(signal.SIGTERM, previous_handler)
-    for note in outcome.notes:
-        click.echo(f"note: {note}", err=True)
+        progress.stop()
+        try:
+            signal.signal(signal.SIGTERM, previous_handler)
+        except (ValueError, TypeError):
+            pass
+    if outcome.status == "io_error":
+        _fail(f"could not write the results: {outcome.message}", EXIT_IO, debug)
     if outcome.status == "stopped":
         click.echo(_paragraph(outcome))
         _fail(f"stopped at a physical limit: {outcome.message}", EXIT_STOPPED, debug)
     if outcome.status != "complete":
         _fail(f"run failed: {outcome.message}" + (f"; steps up to the failure are in {output} (status 'failed')"
-                                                  if outcome.last is not None else ""), EXIT_FAILED, debug)
+                                                  if outcome.written else ""), EXIT_FAILED, debug)
     click.echo(_paragraph(outcome))
+
+
+class _Progress:
+    """A progress bar in cycles whose time estimate counts solves (steps grow, so cycles/s is no guide)."""
+
+    def __init__(self, off: bool):
+        self.off = off
+        self.bar = None
+        self.done = 0
+
+    def start(self, setup) -> None:
+        if self.off or not setup.cycles:
+            return
+        import time
+        self.solves_expected = max(1, estimate_solves(setup))
+        self.solves = 0
+        self.t0 = time.perf_counter()
+        self.total = setup.cycles
+        self.bar = click.progressbar(length=setup.cycles, label="cycles", file=sys.stderr, show_eta=False,
+                                     show_percent=True, item_show_func=self._text)
+        self.bar.__enter__()
+
+    def _text(self, _item) -> str:
+        import time
+        if not self.solves:
+            return ""
+        spent = time.perf_counter() - self.t0
+        left = max(0.0, spent / self.solves * (max(self.solves_expected, self.solves + 1) - self.solves))
+        return f"{self.done}/{self.total}, about {left:.0f} s left"
+
+    def update(self, cycles: int) -> None:
+        if self.bar is None:
+            return
+        self.solves += 1
+        self.done += cycles
+        self.bar.update(cycles, self.done)
+
+    def stop(self) -> None:
+        if self.bar is not None:
+            self.bar.__exit__(None, None, None)
+            self.bar = None
+
+
+def estimate_solves(setup) -> int:
+    """Solves a run is expected to take (measured on the shipped cases; for progress and `check`)."""
+    import math
+    n = setup.cycles
+    if n == 0:
+        return 1
+    if setup.scheme in ("bdf2", "implicit"):
+        # ~25 solves per decade of cycles after the first, ~7 per recorded state landed on (measured)
+        return min(n + 1, int(10 + 12 * math.log10(max(n, 10)) + 7 * len(setup.snapshots)))
+    if setup.scheme == "linear":
+        return n // setup.linear_jump + len(setup.snapshots) + 1
+    return int(n / (setup.linear_jump * 6 + 300)) * 6 + len(setup.snapshots) + 10
 
 
 def _paragraph(outcome) -> str:
@@ -128,7 +190,7 @@ def _paragraph(outcome) -> str:
 
 
 @main.command()
-@click.argument("case_file", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("case_file", type=click.Path(path_type=Path))
 @click.option("--set", "overrides", multiple=True, metavar="KEY.PATH=VALUE", help="Override a case value.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
 def check(case_file: Path, overrides: tuple, debug: bool) -> None:
@@ -146,8 +208,8 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
         f"{g.shape[1]} × {g.shape[0]} elements of {g.dx * 1e3:.4g} × {g.dy * 1e3:.4g} µm"
     click.echo(f"{filled.name}: {filled.cycles} cycles, {filled.dimension.upper()} {filled.geometry.kind}, {cells}")
     click.echo(f"explicit stability limit: {setup.stability_limit:.4g} cycles (solve grid, gap model {setup.gap_model})")
-    est = estimate_cost(setup)
-    click.echo(f"estimate: about {est[0]} contact solves, {est[1]:.2g} s")
+    solves, seconds = estimate_cost(setup)
+    click.echo(f"estimate: about {solves} contact solves, {seconds:.2g} s")
     click.echo("choices:")
     width = max(len(c.key) for c in plan.choices)
     for c in plan.choices:
@@ -160,27 +222,16 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
 
 def estimate_cost(setup) -> tuple[int, float]:
     """(solves, seconds) before a run: solves from the scheme, seconds from one timed contact solve."""
-    import math
     import time
 
     from fretsim.solvers import solve
-    n = setup.cycles
-    if n == 0:
-        solves = 1
-    elif setup.scheme in ("bdf2", "implicit"):
-        # measured: ~25 solves per decade of cycles after the first, ~8 per recorded state landed on
-        solves = int(10 + 25 * math.log10(max(n, 10)) + 8 * len(setup.snapshots))
-        solves = min(solves, n + 1)
-    elif setup.scheme == "linear":
-        solves = n // setup.linear_jump + len(setup.snapshots) + 1
-    else:
-        solves = int(n / (setup.linear_jump * 6 + 300)) * 6 + len(setup.snapshots) + 10
+    solves = estimate_solves(setup)
     op = setup.coarse_compliance or setup.compliance
     gap = setup.coarse_gap if setup.coarse_gap is not None else setup.gap
     t = time.perf_counter()
     solve(op, gap, setup.load, method=setup.method, tol=setup.tolerance)
     cold = time.perf_counter() - t
-    return solves, solves * cold * 0.6  # warm-started solves take about 60 % of a cold one (measured)
+    return solves, solves * cold * 0.5  # a warm-started solve on a window takes about half a cold one (measured)
 
 
 def _show(value) -> str:
@@ -190,45 +241,130 @@ def _show(value) -> str:
 
 
 @main.command()
-@click.argument("results_file", type=click.Path(dir_okay=False, path_type=Path))
-@click.option("--json", "as_json", is_flag=True, help="Machine-readable output for sweeps.")
+@click.argument("results_files", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.option("--json", "as_json", is_flag=True, help="Machine-readable output (strict JSON; null for NaN).")
+@click.option("--csv", "as_csv", is_flag=True, help="One CSV row per file: inputs and summary figures.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
-def summary(results_file: Path, as_json: bool, debug: bool) -> None:
-    """Print the summary figures of RESULTS_FILE (the /summary attributes)."""
-    from fretsim.results import read_results
+def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> None:
+    """Print the summary figures of RESULTS_FILES (the /summary attributes), with the inputs of each run."""
+    import json
 
-    try:
-        res = read_results(results_file)
-    except ValueError as exc:
-        _fail(str(exc), EXIT_BAD_INPUT, debug)
-    data = {"status": res.status, "case_name": res.attrs.get("case_name"), **res.summary}
+    from fretsim.results import read_results, summary_json
+
+    rows, bad = [], []
+    for path in results_files:
+        try:
+            rows.append(summary_json(read_results(path)))
+        except ValueError as exc:
+            if len(results_files) == 1:
+                _fail(str(exc), EXIT_BAD_INPUT, debug)
+            bad.append(str(exc))
+            rows.append({"path": str(path), "status": "unreadable", "message": str(exc)})
     if as_json:
-        click.echo(json.dumps(data, indent=2, sort_keys=False))
+        click.echo(json.dumps(rows[0] if len(rows) == 1 else rows, indent=2, allow_nan=False))
+    elif as_csv:
+        import csv
+        flat = [{**{k: v for k, v in r.items() if not isinstance(v, (dict, list))},
+                 **{f"input_{k}": v for k, v in r.get("inputs", {}).items()},
+                 "overrides": " ".join(r.get("overrides", []))} for r in rows]
+        keys = list(dict.fromkeys(k for r in flat for k in r))
+        w = csv.DictWriter(sys.stdout, fieldnames=keys)
+        w.writeheader()
+        w.writerows(flat)
     else:
-        width = max(len(k) for k in data)
-        for k, v in data.items():
-            click.echo(f"{k:<{width}}  {v:.6g}" if isinstance(v, float) else f"{k:<{width}}  {v}")
+        for r in rows:
+            data = {k: v for k, v in r.items() if not isinstance(v, (dict, list))}
+            width = max(len(k) for k in data)
+            for k, v in data.items():
+                click.echo(f"{k:<{width}}  {v:.6g}" if isinstance(v, float) else f"{k:<{width}}  {v}")
+            if r.get("inputs"):
+                click.echo("inputs  " + ", ".join(f"{k} {v}{' ' + r['input_units'][k] if r['input_units'].get(k) and r['input_units'][k] != '1' else ''}"
+                                                  for k, v in r["inputs"].items()))
+            if r.get("overrides"):
+                click.echo("overrides  " + " ".join(r["overrides"]))
+            if len(rows) > 1:
+                click.echo("")
+    if bad:
+        for b in bad:
+            click.echo(f"fretsim: {b}", err=True)
+        sys.exit(EXIT_BAD_INPUT)
 
 
 @main.command()
-@click.argument("results_file", type=click.Path(dir_okay=False, path_type=Path))
+@click.argument("results_file", type=click.Path(path_type=Path))
 @click.option("-o", "--outdir", type=click.Path(file_okay=False, path_type=Path),
-              help="Directory for the PNGs (default: next to RESULTS_FILE).")
+              help="Directory for the figures (default: next to RESULTS_FILE).")
+@click.option("--format", "fmt", type=click.Choice(["png", "pdf", "svg"]), default="png", show_default=True)
+@click.option("--dpi", type=click.IntRange(50, 1200), default=200, show_default=True)
+@click.option("--log", "log_cycles", is_flag=True, help="Logarithmic cycle axis for the histories.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
-def plot(results_file: Path, outdir: Path | None, debug: bool) -> None:
-    """Write PNG figures of RESULTS_FILE: wear profiles, wear maps, max wear vs cycles, pressure profiles."""
-    from fretsim.plotting import plot_all
+def plot(results_file: Path, outdir: Path | None, fmt: str, dpi: int, log_cycles: bool, debug: bool) -> None:
+    """Write figures of RESULTS_FILE: wear profiles across and along the contact, wear and pressure maps,
+    pressure profiles with the initial Hertz solution, depth and volume against cycles."""
     from fretsim.results import read_results
 
     try:
         res = read_results(results_file)
-        paths = plot_all(res, outdir or results_file.parent)
+    except ValueError as exc:
+        _fail(str(exc), EXIT_BAD_INPUT, debug)
+    from fretsim.plotting import plot_all
+    try:
+        paths = plot_all(res, outdir or results_file.parent, fmt=fmt, dpi=dpi, log_cycles=log_cycles)
     except ValueError as exc:
         _fail(str(exc), EXIT_BAD_INPUT, debug)
     except OSError as exc:
-        _fail(f"cannot write plots: {exc}", EXIT_BAD_INPUT, debug)
+        _fail(f"cannot write figures: {exc.strerror or exc}", EXIT_IO, debug)
     for p in paths:
         click.echo(str(p))
+
+
+@main.command()
+@click.argument("results_file", type=click.Path(path_type=Path))
+@click.option("--csv", "csv_dir", required=True, type=click.Path(file_okay=False, path_type=Path),
+              help="Directory for history.csv, summary.csv, inputs.csv and fields.csv.")
+@click.option("--debug", is_flag=True, help="Show tracebacks.")
+def export(results_file: Path, csv_dir: Path, debug: bool) -> None:
+    """Write RESULTS_FILE as CSV files for spreadsheets (units in the column names)."""
+    from fretsim.export import export_csv
+    from fretsim.results import read_results
+
+    try:
+        paths = export_csv(read_results(results_file), csv_dir)
+    except ValueError as exc:
+        _fail(str(exc), EXIT_BAD_INPUT, debug)
+    except OSError as exc:
+        _fail(f"cannot write {csv_dir}: {exc.strerror or exc}", EXIT_IO, debug)
+    for p in paths:
+        click.echo(str(p))
+
+
+@main.command()
+@click.argument("kind", required=False, default="mccoll_185N")
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+              help="Where to write the case (default: KIND.yaml in the current directory).")
+def init(kind: str, output: Path | None) -> None:
+    """Write a case to start from: a shipped case by name (e.g. mccoll_185N) or a commented template of a
+    geometry (e.g. ball_on_flat).  `fretsim init --help` lists both."""
+    from fretsim.templates import available, template_text
+
+    names = available()
+    if kind not in names:
+        import difflib
+        hint = difflib.get_close_matches(kind, names, n=1)
+        _fail(f"unknown case or geometry {kind!r}" + (f" (did you mean {hint[0]!r}?)" if hint else "")
+              + f"; choose one of {', '.join(names)}", EXIT_BAD_INPUT, False)
+    output = output or Path(f"{kind}.yaml")
+    if output.exists():
+        _fail(f"{output} exists; choose another -o", EXIT_BAD_INPUT, False)
+    output.write_text(template_text(kind))
+    click.echo(str(output))
+
+
+@main.command("case-reference")
+def case_reference() -> None:
+    """Print every case key with its unit, default and meaning (Markdown), from the parser's own schema."""
+    from fretsim.templates import case_reference_markdown
+    click.echo(case_reference_markdown(), nl=False)
 
 
 if __name__ == "__main__":

@@ -1,8 +1,10 @@
-"""PNG figures from a results file (the only module importing matplotlib; Agg backend, no display).
+"""Figures from a results file (the only module importing matplotlib; Agg backend, no display).
 
-Figures after the paper: wear profiles along the centre line (Fig. 17), wear
-maps of both bodies (Figs. 24–25), maximum wear depth against cycles (Figs. 14,
-28), pressure profiles (Fig. 16).  They read only the results file.
+After the paper: wear profiles across the contact (Fig. 17) and, in 3D, along it; pressure profiles (Fig. 16)
+with the initial Hertz solution; wear maps of both bodies on one colour scale (Figs. 24–25) and the pressure
+map (the finite cylinder's end peaks, Fig. 5); maximum depth and wear volume against cycles (Figs. 14, 28)
+with Archard's line and a marker at every contact solve.  They read only the results file: :func:`figures`
+returns the matplotlib figures (tests check what is drawn), :func:`plot_all` saves them.
 """
 from __future__ import annotations
 
@@ -13,87 +15,219 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
+from matplotlib.ticker import ScalarFormatter  # noqa: E402
 
 from fretsim.results import Results  # noqa: E402
-from fretsim.simulate import centre_line  # noqa: E402
+
+STYLES = ["-", "--", "-.", ":", (0, (5, 1)), (0, (3, 1, 1, 1))]
 
 
-def plot_all(res: Results, outdir: str | Path) -> list[Path]:
-    outdir = Path(outdir)
-    outdir.mkdir(parents=True, exist_ok=True)
-    stem = Path(res.path).stem
-    if res.fields.get("cycle") is None or res.fields["cycle"].size == 0:
-        raise ValueError(f"{res.path} has no snapshot fields to plot (status {res.status})")
-    paths = [_profiles(res, outdir / f"{stem}_wear_profiles.png"),
-             _pressure(res, outdir / f"{stem}_pressure_profiles.png"),
-             _history(res, outdir / f"{stem}_max_wear_history.png")]
-    if res.y.size > 1:
-        paths.append(_maps(res, outdir / f"{stem}_wear_maps.png"))
-    return paths
+def centre_row(field_2d: np.ndarray) -> np.ndarray:
+    """Values along y = 0: the middle row, or the mean of the two middle rows when My is even."""
+    ny = field_2d.shape[0]
+    return field_2d[ny // 2] if ny % 2 else 0.5 * (field_2d[ny // 2 - 1] + field_2d[ny // 2])
 
 
-def _title(res: Results, what: str) -> str:
-    return f"{res.attrs.get('case_name', '')}: {what}" + ("" if res.status == "complete" else f" [{res.status}]")
+def _input(res: Results, key: str, default=None):
+    return res.inputs.get(key, (default, ""))[0]
 
 
-def _profiles(res: Results, path: Path) -> Path:
-    return _centre_line_pair(res, path, "wear profiles", [
-        ("wear_depth_moving", "moving body, centre line y = 0", "worn profile, -depth"),
-        ("wear_depth_stationary", "stationary body, centre line y = 0", "worn profile, -depth")], sign=-1.0)
-
-
-def _pressure(res: Results, path: Path) -> Path:
-    return _centre_line_pair(res, path, "pressure profiles", [
-        ("pressure", "moving body (mid-stroke), y = 0", "contact pressure"),
-        ("pressure_stationary_average", "stationary body (stroke average), y = 0", "contact pressure")])
-
-
-def _centre_line_pair(res: Results, path: Path, what: str, panels, sign: float = 1.0) -> Path:
-    """Two panels of a field along the centre line at every snapshot."""
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2), sharex=True)
-    for ax, (name, title, quantity) in zip(axes, panels):
-        for k, n in enumerate(res.fields["cycle"]):
-            ax.plot(res.x, sign * centre_line(res.fields[name][k]), label=f"N = {n}")
-        ax.set_xlabel("x, sliding direction (mm)")
-        ax.set_ylabel(f"{quantity} ({_unit(res, 'fields/' + name)})")
-        ax.set_title(title)
-        ax.grid(alpha=0.3)
-    axes[1].legend(fontsize=8)
-    return _save(fig, res, what, path)
+def title_block(res: Results) -> str:
+    """Case, load, stroke, wear coefficients, model and the --set overrides, for every figure."""
+    name = res.attrs.get("case_name", "")
+    status = "" if res.status == "complete" else f" [{res.status}]"
+    parts = [f"{name}{status}"]
+    if res.inputs:
+        parts.append(f"P = {_input(res, 'normal_load'):.4g} N, δ = ±{_input(res, 'stroke'):.4g} µm, "
+                     f"N = {_input(res, 'cycles')}, k_m = {_input(res, 'moving_wear_coefficient'):.3g}, "
+                     f"k_s = {_input(res, 'stationary_wear_coefficient'):.3g} 1/MPa; "
+                     f"{str(_input(res, 'dimension', '')).upper()} {_input(res, 'geometry', '')}, gap "
+                     f"{_input(res, 'gap_model', '')}, {_input(res, 'scheme', '')}")
+    if res.overrides:
+        parts.append("--set " + " ".join(res.overrides))
+    return "\n".join(parts)
 
 
 def _unit(res: Results, key: str) -> str:
-    return res.units[key].replace("um", "µm")
+    return res.units.get(key, "").replace("um", "µm").replace("mm^3", "mm³")
 
 
-def _save(fig, res: Results, what: str, path: Path) -> Path:
-    fig.suptitle(_title(res, what))
-    fig.tight_layout()
-    fig.savefig(path, dpi=120)
-    plt.close(fig)
-    return path
+def _snapshot_lines(ax, x, curves, labels, sign=1.0):
+    for k, (c, label) in enumerate(zip(curves, labels)):
+        ax.plot(x, sign * c, ls=STYLES[k % len(STYLES)], lw=1.4, label=label)
 
 
-def _history(res: Results, path: Path) -> Path:
-    h = res.history
-    fig, ax = plt.subplots(figsize=(6.5, 4.2))
-    for name, label in (("max_wear_depth_total", "total"), ("max_wear_depth_stationary", "stationary"),
-                        ("max_wear_depth_moving", "moving")):
-        ax.plot(h["cycle"], h[name], label=label, marker="." if h["cycle"].size < 60 else None)
-    ax.set_xlabel("cycles (–)")
-    ax.set_ylabel(f"maximum wear depth ({_unit(res, 'history/max_wear_depth_total')})")
-    ax.grid(alpha=0.3)
-    ax.legend()
-    return _save(fig, res, "maximum wear depth", path)
+def _cycles_label(n: int) -> str:
+    return f"N = {n:,}".replace(",", " ")
 
 
-def _maps(res: Results, path: Path) -> Path:
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.5))
-    for ax, body in zip(axes, ("moving", "stationary")):
-        data = res.fields[f"wear_depth_{body}"][-1]
-        cs = ax.contourf(res.x, res.y, data, levels=20, cmap="viridis")
-        fig.colorbar(cs, ax=ax, label="wear depth (µm)")
+def figures(res: Results, log_cycles: bool = False) -> dict:
+    """name → matplotlib Figure, for what the file holds (a contact-only run has no wear figures)."""
+    if res.fields.get("cycle") is None or res.fields["cycle"].size == 0:
+        raise ValueError(f"{res.path} has no snapshot fields to plot (status {res.status})")
+    worn = res.fields["cycle"] > 0
+    out = {"pressure_profiles": _pressure(res)}
+    if worn.any():
+        out["wear_profiles"] = _profiles(res)
+        out["history"] = _history(res, log_cycles)
+    if res.y.size > 1:
+        out["maps"] = _maps(res)
+    for name, fig in out.items():
+        fig.suptitle(title_block(res), fontsize=9)
+        if not fig.get_layout_engine():
+            fig.tight_layout()
+    return out
+
+
+def plot_all(res: Results, outdir: str | Path, fmt: str = "png", dpi: int = 200, log_cycles: bool = False) -> list[Path]:
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    stem = Path(res.path).stem
+    paths = []
+    for name, fig in figures(res, log_cycles).items():
+        path = outdir / f"{stem}_{name}.{fmt}"
+        fig.savefig(path, dpi=dpi)
+        plt.close(fig)
+        paths.append(path)
+    return paths
+
+
+def _profiles(res: Results):
+    """Wear profiles of both bodies at every worn snapshot: across the contact (y = 0) and, in 3D, along it."""
+    cycles = res.fields["cycle"]
+    worn = np.flatnonzero(cycles > 0)
+    three_d = res.y.size > 1
+    fig, axes = plt.subplots(2 if three_d else 1, 2, figsize=(11, 7.5 if three_d else 4.2), squeeze=False)
+    labels = [_cycles_label(cycles[k]) for k in worn]
+    unit = _unit(res, "fields/wear_depth_moving")
+    for col, body in enumerate(("moving", "stationary")):
+        data = res.fields[f"wear_depth_{body}"]
+        ax = axes[0, col]
+        _snapshot_lines(ax, res.x, [centre_row(data[k]) for k in worn], labels, sign=-1.0)
+        ax.set_xlabel("x, sliding direction (mm)")
+        ax.set_ylabel(f"worn profile, −depth ({unit})")
+        ax.set_title(f"{body} body, across the contact (y = 0)")
+        if three_d:
+            ax = axes[1, col]
+            last = data[worn[-1]]
+            ix = int(np.argmax(centre_row(last)))
+            _snapshot_lines(ax, res.y, [data[k][:, ix] for k in worn], labels, sign=-1.0)
+            ax.set_xlabel("y, across the sliding direction (mm)")
+            ax.set_ylabel(f"worn profile, −depth ({unit})")
+            ax.set_title(f"{body} body, along the contact (x = {res.x[ix]:.3g} mm)")
+    for ax in axes.ravel():
+        ax.grid(alpha=0.3)
+    axes[0, 1].legend(fontsize=8)
+    return fig
+
+
+def hertz_profile(res: Results, x: np.ndarray) -> np.ndarray | None:
+    """The initial Hertz pressure along x (y = 0), from the inputs recorded in the file."""
+    a = _input(res, "hertz_half_width_x")
+    p0 = _input(res, "hertz_peak_pressure")
+    if a is None or p0 is None:
+        return None
+    return p0 * np.sqrt(np.clip(1.0 - (x / a) ** 2, 0.0, None))
+
+
+def _pressure(res: Results):
+    """Pressure at every snapshot along y = 0 (moving body, stroke average) and, in 3D, along x = 0; the N = 0
+    curve is overlaid by Hertz's solution.  The scale follows the worn states: an unworn peak far above them is
+    cut off and labelled, instead of squashing them."""
+    cycles = res.fields["cycle"]
+    three_d = res.y.size > 1
+    fig, axes = plt.subplots(2 if three_d else 1, 2, figsize=(11, 7.5 if three_d else 4.2), squeeze=False)
+    labels = [_cycles_label(c) for c in cycles]
+    unit = _unit(res, "fields/pressure")
+    worn = cycles > 0
+    hertz = hertz_profile(res, res.x)
+    for col, (name, what) in enumerate((("pressure", "moving body (mid-stroke)"),
+                                        ("pressure_stationary_average", "stationary body (stroke average)"))):
+        data = res.fields[name]
+        ax = axes[0, col]
+        rows = [centre_row(d) for d in data]
+        _snapshot_lines(ax, res.x, rows, labels)
+        if name == "pressure" and hertz is not None and 0 in cycles and _input(res, "hertz_line_contact", 1) in (1, 0):
+            ax.plot(res.x, hertz, "k:", lw=1.0, label="Hertz (N = 0)")
+        if worn.any() and (~worn).any():
+            top = 1.25 * max(r.max() for r, w in zip(rows, worn) if w)
+            peak = max(r.max() for r, w in zip(rows, worn) if not w)
+            if peak > top:
+                ax.set_ylim(0, top)
+                ax.annotate(f"N = 0 peak {peak:.4g} {unit} (off scale)", xy=(0.02, 0.95), xycoords="axes fraction",
+                            fontsize=8, va="top")
+        ax.set_xlabel("x, sliding direction (mm)")
+        ax.set_ylabel(f"contact pressure ({unit})")
+        ax.set_title(f"{what}, y = 0")
+        if three_d:
+            ax = axes[1, col]
+            ix = res.x.size // 2
+            _snapshot_lines(ax, res.y, [d[:, ix] for d in data], labels)
+            ax.set_xlabel("y, across the sliding direction (mm)")
+            ax.set_ylabel(f"contact pressure ({unit})")
+            short = what.split(" (")[0]
+            ax.set_title(f"{short}, along y at x = {res.x[ix]:.3g} mm")
+    for ax in axes.ravel():
+        ax.grid(alpha=0.3)
+    axes[0, 0].legend(fontsize=8)
+    return fig
+
+
+def _maps(res: Results):
+    """Final wear of both bodies on one colour scale, and the final pressure."""
+    cycles = res.fields["cycle"]
+    last = len(cycles) - 1
+    wear = [res.fields[f"wear_depth_{b}"][last] for b in ("moving", "stationary")]
+    vmax = max(float(w.max()) for w in wear) or 1.0
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.8), layout="constrained")
+    levels = np.linspace(0.0, vmax, 21)
+    for ax, body, w in zip(axes[:2], ("moving", "stationary"), wear):
+        cs = ax.contourf(res.x, res.y, w, levels=levels, cmap="viridis", extend="neither")
+        ax.set_title(f"{body} body wear, {_cycles_label(cycles[last])}")
+    fig.colorbar(cs, ax=list(axes[:2]), label=f"wear depth ({_unit(res, 'fields/wear_depth_moving')}), one scale")
+    p = res.fields["pressure"][last]
+    pc = axes[2].contourf(res.x, res.y, p, levels=21, cmap="magma")
+    fig.colorbar(pc, ax=axes[2], label=f"contact pressure ({_unit(res, 'fields/pressure')})")
+    axes[2].set_title(f"pressure on the moving body, {_cycles_label(cycles[last])}")
+    for ax in axes:
         ax.set_xlabel("x, sliding direction (mm)")
         ax.set_ylabel("y (mm)")
-        ax.set_title(f"{body} body at N = {res.fields['cycle'][-1]}")
-    return _save(fig, res, "wear maps", path)
+    return fig
+
+
+def _history(res: Results, log_cycles: bool):
+    """Maximum depth and wear volume against cycles, a marker at each solve, Archard's volume line."""
+    h = res.history
+    n = h["cycle"]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    ax = axes[0]
+    for (name, label), ls in zip((("max_wear_depth_total", "total"), ("max_wear_depth_stationary", "stationary"),
+                                  ("max_wear_depth_moving", "moving")), STYLES):
+        ax.plot(n, h[name], ls=ls, marker="o", ms=2.5, lw=1.3, label=label)
+    ax.set_ylabel(f"maximum wear depth ({_unit(res, 'history/max_wear_depth_total')})")
+    ax = axes[1]
+    for (name, label, key), ls in zip((("wear_volume_moving", "moving", "moving_wear_coefficient"),
+                                       ("wear_volume_stationary", "stationary", "stationary_wear_coefficient")),
+                                      STYLES):
+        line, = ax.plot(n, h[name], ls=ls, marker="o", ms=2.5, lw=1.3, label=label)
+        k = _input(res, key)
+        if k is not None:
+            archard = k * _input(res, "normal_load") * 4 * _input(res, "stroke") * 1e-3 * n
+            ax.plot(n, archard, color=line.get_color(), lw=0.8, alpha=0.6, ls=(0, (1, 2)),
+                    label=f"Archard k·P·4δ·N, {label}")
+    ax.set_ylabel(f"wear volume ({_unit(res, 'history/wear_volume_moving')})")
+    for ax in axes:
+        ax.set_xlabel("cycles N (–)")
+        if log_cycles:
+            ax.set_xscale("log")
+        else:
+            fmt = ScalarFormatter(useMathText=False)
+            fmt.set_scientific(False)
+            ax.xaxis.set_major_formatter(fmt)
+            ax.ticklabel_format(axis="x", style="plain")
+            ax.tick_params(axis="x", labelrotation=20)
+        ax.grid(alpha=0.3, which="both")
+        ax.legend(fontsize=8)
+    axes[0].set_title("maximum wear depth (a marker per contact solve)")
+    axes[1].set_title("wear volume against Archard's law")
+    return fig

@@ -1,25 +1,48 @@
-"""The HDF5 results file: layout, crash-safe writer and reader.  The layout is a contract (see README).
+"""The HDF5 results file: layout, crash-safe exclusive writer, and a reader that verifies what it reads.
 
     /                  attrs format_version, fretsim_version, status, status_message, case_name, notes
-    /case              the validated case with defaults and automatic choices filled (YAML text)
+    /case              the validated case with defaults and automatic choices filled (YAML text; attr sha256)
+    /inputs            the resolved inputs as scalar datasets with units; attrs overrides (the --set items), case_file
+    /choices           every automatic choice: key, value, reason, given (one entry each)
     /grid/x, /grid/y   element centres (mm)
-    /history/<name>    one entry per accepted step (cycle, wear depths, volumes, pressure, iterations, time…)
-    /fields/<name>     at the snapshot cycles: wear depths, pressure, stroke-averaged pressure (S, My, Mx)
-    /summary           attrs: the run's headline figures (same names as `fretsim summary`)
-    /checkpoint        the loop's state at the last written step, for `fretsim run --resume`
+    /history/<name>    one entry per accepted step over the dimension ``step``, ``cycle`` its coordinate
+    /fields/<name>     at the snapshot cycles: (cycle, y, x), with ``cycle``, ``y``, ``x`` as dimension scales
+    /summary           attrs: the run's headline figures (same names as `fretsim summary`), and the same values
+                       as scalar datasets each with its ``units``
+    /checkpoint        the loop's state at the last written step, for `fretsim run --resume` (attr sha256)
 
-Crash safety: the writer keeps the run in memory and, at every flush, writes the whole file to a temporary
-file beside it and renames it over the results file (an atomic replacement on POSIX).  The file on disk is
-therefore always a complete, valid HDF5 file — after Ctrl-C, SIGTERM or kill -9 alike — holding every step
-up to the last flush (at most FLUSH_SECONDS old) together with the state to resume from.  Flushes happen
-at the first step, then at most every FLUSH_SECONDS, and at the end.
+The layout is a contract (README): names are only ever added.  Every dataset has ``units`` and ``long_name``,
+and the dimension scales make ``xarray.open_dataset(path, engine="h5netcdf", group="fields")`` come out
+labelled.  Format 1.2 adds /inputs, /choices, the dimension scales, the summary datasets and the checksums to
+1.1; a 1.1 file is still read.
+
+Writing.  The writer keeps the run in memory and at every flush builds the whole file as an in-memory HDF5
+image, writes it with plain file I/O to a temporary file beside the target, fsyncs it and renames it over the
+target (atomic on POSIX).  HDF5 therefore never writes to a disk that can fail: a full disk or an I/O error is
+an ordinary OSError at a known point, after which the temporary is removed and the last good file is intact
+(:class:`ResultsIOError`).  The first placement uses a hard link, which fails if the name appeared meanwhile,
+so a results file is never replaced without overwrite.  Flushes happen at the first step, then at most every
+FLUSH_SECONDS, and at the end.
+
+Claiming.  A run holds an exclusive ``flock`` on a lock file beside its output for as long as it may write it
+(:class:`OutputClaim`), so two runs never share one output, with or without overwrite; the kernel releases the
+lock if the process dies, so a killed run leaves no stale claim.
+
+Reading.  :func:`read_results` checks structure, types, shapes against the grid, sizes before allocating,
+finiteness and the checksums, and refuses a damaged file with the path of what is wrong.
 """
 from __future__ import annotations
 
+import errno
+import fcntl
+import hashlib
+import io
+import json
 import math
 import os
+import stat
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Optional
 
@@ -28,63 +51,182 @@ import numpy as np
 
 from fretsim import __version__
 
-FORMAT_VERSION = "1.1"
+FORMAT_VERSION = "1.2"
+READABLE_FORMATS = ("1.1", "1.2")
 FLUSH_SECONDS = 0.5
+STATUSES = ("running", "complete", "interrupted", "failed", "stopped")
+MAX_DATASET_BYTES = 2**32  # 4 GiB: no results file of this tool holds a larger array
+MAX_NAME = 200  # bytes of the output's base name we accept (temporaries use fixed-length names)
 
-# name: (units, how to get the value from a Step)
+# name: (units, long name, how to get the value from a Step)
 HISTORY = {
-    "cycle": ("cycles", lambda s: s.cycle),
-    "max_wear_depth_moving": ("um", lambda s: s.wear_moving.max() * 1e3),
-    "max_wear_depth_stationary": ("um", lambda s: s.wear_stationary.max() * 1e3),
-    "max_wear_depth_total": ("um", lambda s: (s.wear_moving + s.wear_stationary).max() * 1e3),
-    "wear_volume_moving": ("mm^3", lambda s: s.volume_moving),
-    "wear_volume_stationary": ("mm^3", lambda s: s.volume_stationary),
-    "max_pressure": ("MPa", lambda s: s.pressure.max()),
-    "solver_iterations": ("1", lambda s: s.iterations),
-    "wall_time": ("s", lambda s: s.wall_time),
-    "approach": ("um", lambda s: s.approach * 1e3),
-    "archard_volume_error": ("1", lambda s: s.archard_error),
-    "checkerboard_amplitude": ("1", lambda s: abs(s.checkerboard)),
-    "cycle_jump": ("cycles", lambda s: s.jump),
-    "rejected_steps": ("1", lambda s: s.rejected),
-    "error_estimate_depth": ("1", lambda s: s.error_depth),
-    "error_estimate_pressure": ("1", lambda s: s.error_pressure),
+    "cycle": ("cycles", "cycle number", lambda s: s.cycle),
+    "max_wear_depth_moving": ("um", "maximum wear depth of the moving body", lambda s: s.wear_moving.max() * 1e3),
+    "max_wear_depth_stationary": ("um", "maximum wear depth of the stationary body",
+                                  lambda s: s.wear_stationary.max() * 1e3),
+    "max_wear_depth_total": ("um", "maximum total wear depth", lambda s: (s.wear_moving + s.wear_stationary).max() * 1e3),
+    "wear_volume_moving": ("mm^3", "wear volume of the moving body", lambda s: s.volume_moving),
+    "wear_volume_stationary": ("mm^3", "wear volume of the stationary body", lambda s: s.volume_stationary),
+    "max_pressure": ("MPa", "maximum contact pressure", lambda s: s.pressure.max()),
+    "solver_iterations": ("1", "contact solver iterations", lambda s: s.iterations),
+    "wall_time": ("s", "wall time since the start of the run", lambda s: s.wall_time),
+    "approach": ("um", "rigid-body approach", lambda s: s.approach * 1e3),
+    "archard_volume_error": ("1", "relative difference of the wear volume from k·P·4δ·N", lambda s: s.archard_error),
+    "checkerboard_amplitude": ("1", "odd-even pressure amplitude relative to the mean", lambda s: abs(s.checkerboard)),
+    "cycle_jump": ("cycles", "cycles since the previous step", lambda s: s.jump),
+    "rejected_steps": ("1", "steps rejected since the previous accepted one", lambda s: s.rejected),
+    "error_estimate_depth": ("1", "estimated relative error of the maximum depths", lambda s: s.error_depth),
+    "error_estimate_pressure": ("1", "estimated relative error of the pressure field", lambda s: s.error_pressure),
 }
 INTEGER_HISTORY = {"cycle", "solver_iterations", "cycle_jump", "rejected_steps"}
+HISTORY_V11 = [k for k in HISTORY if not k.startswith("error_estimate")]  # a 1.1 file has these
 FIELDS = {
-    "wear_depth_moving": ("um", lambda s: s.wear_moving * 1e3),
-    "wear_depth_stationary": ("um", lambda s: s.wear_stationary * 1e3),
-    "pressure": ("MPa", lambda s: s.pressure),
-    "pressure_stationary_average": ("MPa", lambda s: s.pressure_average),
+    "wear_depth_moving": ("um", "wear depth of the moving body", lambda s: s.wear_moving * 1e3),
+    "wear_depth_stationary": ("um", "wear depth of the stationary body", lambda s: s.wear_stationary * 1e3),
+    "pressure": ("MPa", "contact pressure on the moving body at mid-stroke", lambda s: s.pressure),
+    "pressure_stationary_average": ("MPa", "stroke-averaged pressure on the stationary body",
+                                    lambda s: s.pressure_average),
 }
 SUMMARY_UNITS = {
     "cycles": "cycles", "contact_solves": "1", "wall_time_s": "s", "max_wear_depth_moving_um": "um",
     "max_wear_depth_stationary_um": "um", "centre_wear_depth_moving_um": "um",
-    "centre_wear_depth_stationary_um": "um", "scar_width_stationary_mm": "mm", "wear_volume_moving_mm3": "mm^3",
-    "wear_volume_stationary_mm3": "mm^3", "archard_volume_error": "1", "max_pressure_MPa": "MPa",
-    "linear_jump": "cycles", "stability_limit_linear": "cycles", "element_size_x_um": "um",
-    "element_size_y_um": "um", "elements_x": "1", "elements_y": "1", "scar_width_moving_mm": "mm",
+    "centre_wear_depth_stationary_um": "um", "scar_width_stationary_mm": "mm", "scar_width_moving_mm": "mm",
+    "wear_volume_moving_mm3": "mm^3", "wear_volume_stationary_mm3": "mm^3", "archard_volume_error": "1",
+    "max_pressure_MPa": "MPa", "linear_jump": "cycles", "stability_limit_linear": "cycles",
+    "element_size_x_um": "um", "element_size_y_um": "um", "elements_x": "1", "elements_y": "1",
     "error_estimate_depth": "1", "error_estimate_pressure": "1",
 }
+NAN_SUMMARY = {"element_size_y_um"}  # NaN in 2D by definition
+
+
+class ResultsIOError(OSError):
+    """Writing the results failed (disk full, I/O error, directory gone); the last good file is intact."""
+
+
+class OutputBusy(Exception):
+    """Another live run holds the output."""
+
+
+def _lock_path(path: Path) -> Path:
+    digest = hashlib.sha1(path.name.encode()).hexdigest()[:16]
+    return path.with_name(f".fretsim-{digest}.lock")
+
+
+class OutputClaim:
+    """An exclusive claim on an output name, held for the life of a run (flock on a lock file beside it)."""
+
+    def __init__(self, path: str | Path):
+        self.path = Path(path)
+        self.lock = _lock_path(self.path)
+        self.fd: Optional[int] = None
+
+    def acquire(self) -> "OutputClaim":
+        while True:
+            fd = os.open(self.lock, os.O_CREAT | os.O_RDWR, 0o644)
+            try:
+                fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            except OSError as exc:
+                os.close(fd)
+                if exc.errno in (errno.EWOULDBLOCK, errno.EAGAIN, errno.EACCES):
+                    raise OutputBusy(f"{self.path}: another fretsim run is writing this file; wait for it, or "
+                                     f"choose another -o") from None
+                raise
+            # the lock file may have been unlinked by its previous holder after we opened it: then retry
+            try:
+                if os.fstat(fd).st_ino == os.stat(self.lock).st_ino:
+                    self.fd = fd
+                    os.ftruncate(fd, 0)
+                    os.write(fd, f"{os.getpid()}\n".encode())
+                    return self
+            except FileNotFoundError:
+                pass
+            os.close(fd)
+
+    def release(self) -> None:
+        if self.fd is None:
+            return
+        try:
+            os.unlink(self.lock)
+        except OSError:
+            pass
+        os.close(self.fd)
+        self.fd = None
+
+    def __enter__(self):
+        return self.acquire()
+
+    def __exit__(self, *exc):
+        self.release()
+
+
+def check_output_path(path: str | Path, protect: tuple = ()) -> Path:
+    """An output name that can be a results file: not a directory, not one of ``protect`` (the case file), in an
+    existing directory, of a sane length.  Raises ValueError with the reason."""
+    text = str(path)
+    p = Path(path)
+    if text in ("", "-"):
+        raise ValueError(f"{text!r} is not a file name; results go to an HDF5 file, e.g. -o out.h5")
+    if text.endswith(os.sep) or p.is_dir():
+        raise ValueError(f"{text} is a directory; give a file name, e.g. -o {os.path.join(text, 'out.h5')}")
+    if len(p.name.encode()) > MAX_NAME:
+        raise ValueError(f"the output name is {len(p.name.encode())} bytes long; at most {MAX_NAME}")
+    parent = p.parent if str(p.parent) else Path(".")
+    if not parent.is_dir():
+        raise ValueError(f"the directory {parent} does not exist; create it first")
+    for other in protect:
+        if other is not None and Path(other).exists() and p.exists() and os.path.samefile(p, other):
+            raise ValueError(f"{text} is the case file itself; choose another output name")
+        if other is not None and os.path.abspath(p) == os.path.abspath(other):
+            raise ValueError(f"{text} is the case file itself; choose another output name")
+    if p.exists() and not stat.S_ISREG(os.stat(p).st_mode):
+        raise ValueError(f"{text} exists and is not a regular file")
+    return p
+
+
+def _checkpoint_digest(state: dict) -> str:
+    h = hashlib.sha256()
+    for key in sorted(state):
+        value = state[key]
+        if value is None:  # not written, so not hashed
+            continue
+        h.update(key.encode())
+        if isinstance(value, list):
+            for a in value:
+                a = np.ascontiguousarray(a)
+                h.update(f"{a.dtype.str}{a.shape}".encode())
+                h.update(a.tobytes())
+        elif isinstance(value, np.ndarray):
+            a = np.ascontiguousarray(value)
+            h.update(f"{a.dtype.str}{a.shape}".encode())
+            h.update(a.tobytes())
+        else:
+            h.update(repr(_plain(value)).encode())
+    return h.hexdigest()
+
+
+def _long_name(key: str) -> str:
+    return key.replace("_", " ")
 
 
 class ResultsWriter:
     """Observer that records each accepted step and keeps the results file complete on disk.
 
     ``previous`` (a :class:`Results` read back from an interrupted run) seeds the history and fields, so a
-    resumed run appends to what was there.
+    resumed run appends to what was there.  ``replace`` allows replacing an existing file (overwrite, resume).
     """
 
     def __init__(self, path: str | Path, case_yaml: str, case_name: str, grid, notes=(), overwrite: bool = False,
-                 previous: Optional["Results"] = None, choices=()):
+                 previous: Optional["Results"] = None, choices=(), inputs: Optional[dict] = None):
         self.path = Path(path)
-        if self.path.exists() and not overwrite and previous is None:
+        self.replace = overwrite or previous is not None
+        if self.path.exists() and not self.replace:
             raise FileExistsError(f"{self.path} exists")
         self.case_yaml, self.case_name, self.grid, self.notes = case_yaml, case_name, grid, tuple(notes)
         self.choices = tuple(choices)
+        self.inputs = inputs or {}
         if previous is not None:
-            self.rows = [list(r) for r in zip(*(previous.history[k] for k in HISTORY))] if len(
-                previous.history.get("cycle", [])) else []
+            self.rows = [list(r) for r in zip(*(previous.history.get(k, np.zeros(len(previous.history["cycle"])))
+                                                for k in HISTORY))] if len(previous.history.get("cycle", [])) else []
             self.fields = {k: list(previous.fields[k]) for k in FIELDS}
             self.field_cycles = list(previous.fields["cycle"])
         else:
@@ -92,12 +234,13 @@ class ResultsWriter:
         self.status, self.message, self.summary = "running", "", {}
         self.state: Optional[dict] = None
         self._flushed = -math.inf
+        self._placed = self.path.exists() and self.replace
 
     def on_step(self, setup, step) -> None:
-        self.rows.append([get(step) for _, get in HISTORY.values()])
+        self.rows.append([get(step) for _, _, get in HISTORY.values()])
         if step.is_snapshot and (not self.field_cycles or self.field_cycles[-1] != step.cycle):
             self.field_cycles.append(step.cycle)
-            for name, (_, get) in FIELDS.items():
+            for name, (_, _, get) in FIELDS.items():
                 self.fields[name].append(np.array(get(step)))
         self.state = step.state
         # the first step (so the file exists at once), then at most every FLUSH_SECONDS: each flush rewrites the
@@ -110,47 +253,108 @@ class ResultsWriter:
         self.summary = summary or {}
         self.flush()
 
+    def image(self) -> bytes:
+        """The whole results file as bytes (an in-memory HDF5 image)."""
+        buf = io.BytesIO()
+        with h5py.File(buf, "w") as f:
+            self._write(f)
+        return buf.getvalue()
+
     def flush(self) -> None:
-        """Write the whole file beside the target and rename it over the target (atomic)."""
-        tmp = self.path.with_name(f".{self.path.name}.{os.getpid()}.tmp")
+        """Write the whole file beside the target and move it over the target (atomic); ResultsIOError if the
+        disk refuses, with the last good file left as it was and no temporary left behind."""
+        data = self.image()
+        tmp = self.path.with_name(f".fretsim-{os.getpid()}-{os.urandom(4).hex()}.tmp")
         try:
-            with h5py.File(tmp, "w") as f:
-                self._write(f)
-            os.replace(tmp, self.path)
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+            try:
+                view = memoryview(data)
+                while view:
+                    view = view[os.write(fd, view):]
+                os.fsync(fd)
+            finally:
+                os.close(fd)
+            if self._placed:
+                os.replace(tmp, self.path)
+            else:
+                try:
+                    os.link(tmp, self.path)  # fails if the name appeared meanwhile: never clobber
+                except FileExistsError:
+                    if not self.replace:
+                        raise ResultsIOError(errno.EEXIST, f"{self.path} appeared while this run started; nothing "
+                                                           f"of it was replaced") from None
+                    os.replace(tmp, self.path)
+                self._placed = True
+            _fsync_dir(self.path.parent)
+        except ResultsIOError:
+            raise
+        except OSError as exc:
+            what = {errno.ENOSPC: "the disk is full", errno.EDQUOT: "the disk quota is exceeded",
+                    errno.EIO: "an I/O error", errno.ENOENT: "its directory has gone",
+                    errno.EROFS: "the file system is read-only", errno.EACCES: "permission denied"}.get(
+                exc.errno, exc.strerror or str(exc))
+            raise ResultsIOError(exc.errno, f"cannot write {self.path}: {what}") from None
         finally:
-            if tmp.exists():
+            try:
                 tmp.unlink()
+            except OSError:
+                pass
         self._flushed = time.monotonic()
 
     def _write(self, f: h5py.File) -> None:
         grid = self.grid
+        text = h5py.string_dtype()
         f.attrs.update(format_version=FORMAT_VERSION, fretsim_version=__version__, status=self.status,
                        status_message=self.message, case_name=self.case_name, notes="\n".join(self.notes))
-        f.create_dataset("case", data=self.case_yaml, dtype=h5py.string_dtype())
-        g = f.create_group("grid")
-        for name, values in (("x", grid.x), ("y", grid.y)):
-            g.create_dataset(name, data=values).attrs["units"] = "mm"
-        g.attrs.update(dx_mm=grid.dx, dy_mm=grid.dy, plane_strain=grid.plane_strain)
-        h = f.create_group("history")
-        rows = np.array(self.rows, dtype=float).reshape(len(self.rows), len(HISTORY))
-        for j, (name, (units, _)) in enumerate(HISTORY.items()):
-            data = rows[:, j].astype("i8") if name in INTEGER_HISTORY else rows[:, j]
-            h.create_dataset(name, data=data).attrs["units"] = units
-        fl = f.create_group("fields")
-        ny, nx = grid.shape
-        fl.create_dataset("cycle", data=np.array(self.field_cycles, dtype="i8")).attrs["units"] = "cycles"
-        for name, (units, _) in FIELDS.items():
-            data = np.array(self.fields[name]).reshape(len(self.fields[name]), ny, nx)
-            fl.create_dataset(name, data=data).attrs["units"] = units
+        c = f.create_dataset("case", data=self.case_yaml, dtype=text)
+        c.attrs["sha256"] = hashlib.sha256(self.case_yaml.encode()).hexdigest()
+        c.attrs["long_name"] = "the validated case with every default and automatic choice filled (YAML)"
+        self._write_inputs(f)
         ch = f.create_group("choices")
-        text = h5py.string_dtype()
         ch.create_dataset("key", data=[c.key for c in self.choices], dtype=text)
         ch.create_dataset("value", data=[_value_text(c.value) for c in self.choices], dtype=text)
         ch.create_dataset("reason", data=[c.reason for c in self.choices], dtype=text)
         ch.create_dataset("given", data=np.array([c.given for c in self.choices], dtype=np.int8))
+        g = f.create_group("grid")
+        for name, values in (("x", grid.x), ("y", grid.y)):
+            ds = g.create_dataset(name, data=values)
+            ds.attrs.update(units="mm", long_name=f"element centre, {'sliding direction' if name == 'x' else 'across it'}")
+        g.attrs.update(dx_mm=grid.dx, dy_mm=grid.dy, plane_strain=np.int8(grid.plane_strain))
+        h = f.create_group("history")
+        n = len(self.rows)
+        rows = np.array(self.rows, dtype=float).reshape(n, len(HISTORY))
+        step = h.create_dataset("step", data=np.arange(n, dtype="i8"))
+        step.make_scale("step")
+        step.attrs.update(units="1", long_name="accepted step")
+        for j, (name, (units, long_name, _)) in enumerate(HISTORY.items()):
+            data = rows[:, j].astype("i8") if name in INTEGER_HISTORY else rows[:, j]
+            ds = h.create_dataset(name, data=data)
+            ds.attrs.update(units=units, long_name=long_name)
+            ds.dims[0].attach_scale(step)
+            if name != "cycle":
+                ds.attrs["coordinates"] = "cycle"
+        fl = f.create_group("fields")
+        ny, nx = grid.shape
+        cyc = fl.create_dataset("cycle", data=np.array(self.field_cycles, dtype="i8"))
+        cyc.make_scale("cycle")
+        cyc.attrs.update(units="cycles", long_name="cycle number of the snapshot")
+        scales = [cyc]
+        for name, values in (("y", grid.y), ("x", grid.x)):
+            ds = fl.create_dataset(name, data=values)
+            ds.make_scale(name)
+            ds.attrs.update(units="mm", long_name=f"element centre, {'sliding direction' if name == 'x' else 'across it'}")
+            scales.append(ds)
+        for name, (units, long_name, _) in FIELDS.items():
+            data = np.array(self.fields[name]).reshape(len(self.fields[name]), ny, nx)
+            ds = fl.create_dataset(name, data=data)
+            ds.attrs.update(units=units, long_name=long_name)
+            for axis, scale in enumerate(scales):
+                ds.dims[axis].attach_scale(scale)
         s = f.create_group("summary")
         for key, value in self.summary.items():
             s.attrs[key] = value
+            ds = s.create_dataset(key, data=value)
+            ds.attrs.update(units=SUMMARY_UNITS.get(key, "1"), long_name=_long_name(key))
         if self.summary:
             s.attrs["units"] = ", ".join(f"{k}: {SUMMARY_UNITS.get(k, '1')}" for k in self.summary)
         if self.state is not None:
@@ -158,10 +362,33 @@ class ResultsWriter:
             for key, value in self.state.items():
                 if isinstance(value, np.ndarray):
                     c.create_dataset(key, data=value)
-                elif isinstance(value, list):  # a list of arrays (the adaptive scheme's batch)
+                elif isinstance(value, list):  # a list of arrays (the schemes' memory)
                     c.create_dataset(key, data=np.array(value)) if value else c.attrs.__setitem__(key + "_empty", 1)
                 elif value is not None:
                     c.attrs[key] = value
+            c.attrs["sha256"] = _checkpoint_digest(self.state)
+
+    def _write_inputs(self, f: h5py.File) -> None:
+        g = f.create_group("inputs")
+        for key, (value, units, long_name) in self.inputs.get("values", {}).items():
+            ds = g.create_dataset(key, data=value if not isinstance(value, str) else value,
+                                  dtype=h5py.string_dtype() if isinstance(value, str) else None)
+            ds.attrs.update(units=units, long_name=long_name)
+        g.attrs["overrides"] = json.dumps(list(self.inputs.get("overrides", [])))
+        g.attrs["case_file"] = str(self.inputs.get("case_file", ""))
+
+
+def _fsync_dir(directory: Path) -> None:
+    try:
+        fd = os.open(directory if str(directory) else ".", os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
 
 
 def _value_text(value) -> str:
@@ -184,61 +411,227 @@ class Results:
     summary: dict
     units: dict
     checkpoint: Optional[dict] = None
-    choices: list = None  # (key, value, reason) of every automatic choice
+    choices: list = field(default_factory=list)  # (key, value, reason) of every automatic choice
+    inputs: dict = field(default_factory=dict)  # name: (value, units)
+    overrides: list = field(default_factory=list)
 
     @property
     def status(self) -> str:
         return self.attrs.get("status", "")
 
+    def to_xarray(self):
+        """The fields as an xarray Dataset over (cycle, y, x) with units, the history as another over step.
 
-def read_results(path: str | Path) -> Results:
-    """Read a results file; raises ``ValueError`` with a clear message if it is not one."""
+        Returns ``(fields, history)``; needs xarray (``pip install xarray``).
+        """
+        import xarray as xr
+        coords = {"cycle": ("cycle", self.fields["cycle"], {"units": "cycles"}), "y": ("y", self.y, {"units": "mm"}),
+                  "x": ("x", self.x, {"units": "mm"})}
+        fields = xr.Dataset({k: (("cycle", "y", "x"), v, {"units": self.units.get(f"fields/{k}", "")})
+                             for k, v in self.fields.items() if k != "cycle"}, coords=coords,
+                            attrs={"case_name": self.attrs.get("case_name", ""), "status": self.status})
+        history = xr.Dataset({k: ("step", v, {"units": self.units.get(f"history/{k}", "")})
+                              for k, v in self.history.items() if k not in ("cycle", "step")},
+                             coords={"step": np.arange(len(self.history["cycle"])),
+                                     "cycle": ("step", self.history["cycle"], {"units": "cycles"})})
+        return fields, history
+
+
+class _Damaged(ValueError):
+    pass
+
+
+def _regular_file(path: str | Path) -> None:
     try:
-        with h5py.File(path, "r") as f:
-            if "format_version" not in f.attrs:
-                raise ValueError(f"{path} is an HDF5 file but not a fretsim results file (no format_version)")
-            units = {}
-            history = {}
-            for k, ds in f["history"].items():
-                history[k] = ds[()]
-                units[f"history/{k}"] = ds.attrs.get("units", "")
-            fields = {}
-            for k, ds in f["fields"].items():
-                fields[k] = ds[()]
-                units[f"fields/{k}"] = ds.attrs.get("units", "")
-            checkpoint = None
-            if "checkpoint" in f:
-                c = f["checkpoint"]
-                checkpoint = {k: ds[()] for k, ds in c.items()}
-                for k, v in c.attrs.items():
-                    if k.endswith("_empty"):
-                        checkpoint[k[:-6]] = []
-                    else:
-                        checkpoint[k] = _plain(v)
-            choices = []
-            if "choices" in f:
-                c = f["choices"]
-                choices = list(zip(*(( [v.decode() if isinstance(v, bytes) else str(v) for v in c[k][()]])
-                                     for k in ("key", "value", "reason"))))
-            case = f["case"][()]
-            return Results(path=str(path), attrs={k: _plain(v) for k, v in f.attrs.items()},
-                           case_yaml=case.decode() if isinstance(case, bytes) else str(case),
-                           x=f["grid/x"][()], y=f["grid/y"][()], history=history, fields=fields,
-                           summary={k: _plain(v) for k, v in f["summary"].attrs.items() if k != "units"},
-                           units=units, checkpoint=checkpoint, choices=choices)
+        st = os.stat(path)
     except FileNotFoundError:
         raise ValueError(f"{path}: no such results file") from None
     except OSError as exc:
-        raise ValueError(f"{path}: not a readable HDF5 results file ({exc})") from None
-    except KeyError as exc:
-        raise ValueError(f"{path}: not a complete fretsim results file (missing {exc})") from None
+        raise ValueError(f"{path}: cannot read it ({exc.strerror})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise ValueError(f"{path}: is a directory, not a results file")
+    if not stat.S_ISREG(st.st_mode):
+        raise ValueError(f"{path}: not a regular file (a FIFO, device or socket); expected an HDF5 results file")
+
+
+def _dataset(f, path: str, ndim: Optional[int] = None, numeric: bool = True, shape: Optional[tuple] = None):
+    obj = f.get(path)
+    if obj is None:
+        raise _Damaged(f"/{path}: missing")
+    if not isinstance(obj, h5py.Dataset):
+        raise _Damaged(f"/{path}: expected a dataset, found a {type(obj).__name__.lower()}")
+    if ndim is not None and obj.ndim != ndim:
+        raise _Damaged(f"/{path}: expected {ndim} dimension(s), found shape {obj.shape}")
+    if shape is not None and obj.shape != shape:
+        raise _Damaged(f"/{path}: expected shape {shape}, found {obj.shape}")
+    if numeric and obj.dtype.kind not in "iuf":
+        raise _Damaged(f"/{path}: expected numbers, found data of type {obj.dtype}")
+    if obj.size * max(obj.dtype.itemsize, 1) > MAX_DATASET_BYTES:
+        raise _Damaged(f"/{path}: declares {obj.size:.3g} values ({obj.size * obj.dtype.itemsize / 2**30:.1f} GiB), "
+                       f"more than any results file holds")
+    data = obj[()]
+    if numeric and data.dtype.kind == "f" and not np.isfinite(data).all():
+        raise _Damaged(f"/{path}: holds non-finite values (NaN or infinity)")
+    return data
+
+
+def _group(f, path: str):
+    obj = f.get(path)
+    if obj is None:
+        raise _Damaged(f"/{path}: missing")
+    if not isinstance(obj, h5py.Group):
+        raise _Damaged(f"/{path}: expected a group, found a {type(obj).__name__.lower()}")
+    return obj
+
+
+def _text(value) -> str:
+    if isinstance(value, bytes):
+        return value.decode("utf-8", "replace")
+    if isinstance(value, np.ndarray) and value.shape == ():
+        return _text(value[()])
+    return str(value)
+
+
+def read_results(path: str | Path, for_resume: bool = False) -> Results:
+    """Read a results file, verifying it; raises ``ValueError`` naming the file and what is wrong.
+
+    ``for_resume`` also requires a complete, intact checkpoint that fits the grid.
+    """
+    _regular_file(path)
+    try:
+        with h5py.File(path, "r") as f:
+            return _read(f, str(path), for_resume)
+    except _Damaged as exc:
+        raise ValueError(f"{path}: damaged or not a fretsim results file: {exc}") from None
+    except (OSError, RuntimeError, KeyError, TypeError, IndexError, AttributeError, UnicodeDecodeError) as exc:
+        raise ValueError(f"{path}: not a readable fretsim results file ({type(exc).__name__}: "
+                         f"{str(exc)[:200]})") from None
+
+
+def _read(f, path: str, for_resume: bool) -> Results:
+    if "format_version" not in f.attrs:
+        raise ValueError(f"{path} is an HDF5 file but not a fretsim results file (no format_version)")
+    version = _text(f.attrs["format_version"])
+    if version not in READABLE_FORMATS:
+        raise _Damaged(f"format_version {version!r} is not one this fretsim reads ({', '.join(READABLE_FORMATS)})")
+    attrs = {k: _plain(v) for k, v in f.attrs.items()}
+    if attrs.get("status") not in STATUSES:
+        raise _Damaged(f"the status {str(attrs.get('status'))[:40]!r} is not one of {', '.join(STATUSES)}")
+    case_ds = f.get("case")
+    if not isinstance(case_ds, h5py.Dataset) or case_ds.dtype.kind not in "OS" or case_ds.shape != ():
+        raise _Damaged("/case: missing or not a text")
+    case_yaml = _text(case_ds[()])
+    if "sha256" in case_ds.attrs and hashlib.sha256(case_yaml.encode()).hexdigest() != _text(case_ds.attrs["sha256"]):
+        raise _Damaged("/case: its text does not match its checksum")
+    x = _dataset(f, "grid/x", 1)
+    y = _dataset(f, "grid/y", 1)
+    if not (x.size and y.size) or (x.size > 1 and not (np.diff(x) > 0).all()) or (y.size > 1 and not (np.diff(y) > 0).all()):
+        raise _Damaged("/grid: x and y must be increasing element centres")
+    ny, nx = y.size, x.size
+    units: dict = {}
+    hist_group = _group(f, "history")
+    expected = HISTORY if version >= "1.2" else {k: HISTORY[k] for k in HISTORY_V11}
+    history = {}
+    for k in expected:
+        history[k] = _dataset(f, f"history/{k}", 1)
+        units[f"history/{k}"] = _text(hist_group[k].attrs.get("units", ""))
+    lengths = {v.shape[0] for v in history.values()}
+    if len(lengths) > 1:
+        raise _Damaged(f"/history: its entries have different lengths {sorted(lengths)}")
+    fl = _group(f, "fields")
+    cycles = _dataset(f, "fields/cycle", 1)
+    units["fields/cycle"] = "cycles"
+    fields = {"cycle": cycles}
+    for k in FIELDS:
+        fields[k] = _dataset(f, f"fields/{k}", 3, shape=(cycles.size, ny, nx))
+        units[f"fields/{k}"] = _text(fl[k].attrs.get("units", ""))
+    summary = {}
+    for k, v in _group(f, "summary").attrs.items():
+        if k == "units":
+            continue
+        v = _plain(v)
+        if isinstance(v, (list, tuple, np.ndarray)) or not isinstance(v, (int, float, str, type(None))):
+            raise _Damaged(f"/summary: {k} is not a single value")
+        if isinstance(v, float) and not math.isfinite(v) and k not in NAN_SUMMARY:
+            raise _Damaged(f"/summary: {k} is not finite")
+        summary[k] = v
+    checkpoint = _read_checkpoint(f, (ny, nx)) if "checkpoint" in f else None
+    if for_resume and checkpoint is None:
+        raise _Damaged("/checkpoint: missing; the run cannot be resumed (it was written before its first step)")
+    choices = []
+    if "choices" in f:
+        c = _group(f, "choices")
+        cols = [[_text(v) for v in _dataset(f, f"choices/{k}", 1, numeric=False)] for k in ("key", "value", "reason")]
+        choices = list(zip(*cols))
+        del c
+    inputs, overrides = {}, []
+    if "inputs" in f:
+        g = _group(f, "inputs")
+        for k, ds in g.items():
+            if isinstance(ds, h5py.Dataset) and ds.shape == ():
+                value = ds[()]
+                inputs[k] = (_text(value) if isinstance(value, bytes) else _plain(value), _text(ds.attrs.get("units", "")))
+        try:
+            overrides = [str(o) for o in json.loads(_text(g.attrs.get("overrides", "[]")))]
+        except (ValueError, TypeError):
+            raise _Damaged("/inputs: its overrides attribute is not a JSON list") from None
+    return Results(path=path, attrs=attrs, case_yaml=case_yaml, x=x, y=y, history=history, fields=fields,
+                   summary=summary, units=units, checkpoint=checkpoint, choices=choices, inputs=inputs,
+                   overrides=overrides)
+
+
+def _read_checkpoint(f, shape: tuple) -> dict:
+    c = _group(f, "checkpoint")
+    state: dict = {}
+    for k, ds in c.items():
+        if not isinstance(ds, h5py.Dataset):
+            raise _Damaged(f"/checkpoint/{k}: expected a dataset")
+        data = _dataset(f, f"checkpoint/{k}")
+        if k in ("h_m", "h_s", "p", "p_prev") and data.shape != shape:
+            raise _Damaged(f"/checkpoint/{k}: shape {data.shape} does not fit the grid {shape}")
+        if k in ("history", "batch") and (data.ndim != 3 or data.shape[1:] != shape):
+            raise _Damaged(f"/checkpoint/{k}: shape {data.shape} does not fit the grid {shape}")
+        state[k] = data
+    digest = None
+    for k, v in c.attrs.items():
+        if k == "sha256":
+            digest = _text(v)
+        elif k.endswith("_empty"):
+            state[k[:-6]] = []
+        else:
+            v = _plain(v)
+            if isinstance(v, float) and not math.isfinite(v):
+                raise _Damaged(f"/checkpoint: {k} is not finite")
+            state[k] = v
+    for k in ("history", "batch"):
+        if isinstance(state.get(k), np.ndarray):
+            state[k] = list(state[k])
+    if digest is not None:
+        if _checkpoint_digest(state) != digest:
+            raise _Damaged("/checkpoint: its contents do not match its checksum")
+    for key in ("n", "h_m", "h_s", "p"):
+        if key not in state:
+            raise _Damaged(f"/checkpoint/{key}: missing")
+    return state
 
 
 def _plain(v):
     if isinstance(v, bytes):
-        return v.decode()
+        return v.decode("utf-8", "replace")
     if isinstance(v, np.generic):
         v = v.item()
-    if isinstance(v, float) and math.isnan(v):
-        return None
     return v
+
+
+def summary_json(res: Results) -> dict:
+    """The summary, the inputs and the overrides as strict JSON-able values (NaN and infinity as null)."""
+    def clean(v):
+        if isinstance(v, float) and not math.isfinite(v):
+            return None
+        return v
+    data = {"status": res.status, "case_name": res.attrs.get("case_name"), "path": res.path}
+    data.update({k: clean(v) for k, v in res.summary.items()})
+    data["inputs"] = {k: clean(v[0]) for k, v in res.inputs.items()}
+    data["input_units"] = {k: v[1] for k, v in res.inputs.items()}
+    data["overrides"] = list(res.overrides)
+    return data

@@ -275,6 +275,16 @@ class _Loop:
         self._check_body(p)
         return step
 
+    def current_step(self) -> Step:
+        """The current state as a step record, without a solve (a resumed run at its end)."""
+        from fretsim.solvers.result import ContactResult
+        p = self.p
+        res = ContactResult(p, float("nan"), p > 0, 0, True, "restored from the checkpoint")
+        step = _record(self.s, self.n, self.h_m, self.h_s, p, res, self.t0 - self.elapsed)
+        step.error_depth = max(_rel_scalar(self.err_abs_m, self.h_m), _rel_scalar(self.err_abs_s, self.h_s))
+        step.state = self.state()
+        return step
+
     def _check_body(self, p) -> None:
         """Stop where the geometry stops meaning anything: worn through, or a scar past the limits of Eqs. 9-10."""
         s = self.s
@@ -314,6 +324,8 @@ class _Loop:
             step = self.emit(p, res, 0)
         else:
             self.restore(resume)
+            if self.n >= s.cycles:  # killed as it finished: the state is the last step
+                return self.current_step()
         if s.cycles == 0 or self.n >= s.cycles:
             return step
         if s.scheme in ("bdf2", "implicit"):

@@ -173,8 +173,8 @@ def test_interrupted_runs_resume_to_identical_arrays(tmp_path, overrides, stops)
         _same_arrays(full, read_results(part))
 
 
-LONG = ["--set", "model.dimension=2d", "--set", "jumping.scheme=linear", "--set", "loading.cycles=60000",
-        "--set", "output.snapshots=[0, 20000, 40000, 60000]"]
+LONG = ["--set", "model.dimension=2d", "--set", "jumping.scheme=linear", "--set", "loading.cycles=150000",
+        "--set", "output.snapshots=[0, 50000, 100000, 150000]"]
 
 
 def _kill_at(tmp_path, sig, rows, name):

@@ -1,0 +1,45 @@
+"""A results file as CSV files for spreadsheets: units in the column names, one row per step or element."""
+from __future__ import annotations
+
+import csv
+from pathlib import Path
+
+import numpy as np
+
+from fretsim.results import SUMMARY_UNITS, Results
+
+
+def _col(name: str, units: str) -> str:
+    return f"{name} [{units}]" if units and units != "1" else name
+
+
+def export_csv(res: Results, outdir: str | Path) -> list[Path]:
+    """Write history.csv, summary.csv, inputs.csv and fields.csv (long format: cycle, x, y, fields) to outdir."""
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    paths = []
+
+    def write(name: str, header: list, rows) -> None:
+        path = outdir / name
+        with open(path, "w", newline="") as fh:
+            w = csv.writer(fh)
+            w.writerow(header)
+            w.writerows(rows)
+        paths.append(path)
+
+    keys = [k for k in res.history if k != "step"]
+    write("history.csv", [_col(k, res.units.get(f"history/{k}", "")) for k in keys],
+          zip(*(res.history[k].tolist() for k in keys)))
+    write("summary.csv", ["quantity", "value", "units"],
+          [(k, v, SUMMARY_UNITS.get(k, "1")) for k, v in res.summary.items()])
+    write("inputs.csv", ["input", "value", "units"],
+          [(k, v, u) for k, (v, u) in res.inputs.items()] + [("overrides", " ".join(res.overrides), "")])
+    names = [k for k in res.fields if k != "cycle"]
+    X, Y = np.meshgrid(res.x, res.y)
+    rows = []
+    for s, cycle in enumerate(res.fields["cycle"]):
+        cols = [np.full(X.size, cycle), X.ravel(), Y.ravel()] + [res.fields[k][s].ravel() for k in names]
+        rows.extend(zip(*(c.tolist() for c in cols)))
+    write("fields.csv", ["cycle", "x [mm]", "y [mm]"] + [_col(k, res.units.get(f"fields/{k}", "")) for k in names],
+          rows)
+    return paths
