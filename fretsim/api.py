@@ -215,13 +215,15 @@ def _execute(setup, filled, plan, output, overwrite, progress, observers, resume
     except SimulationError as exc:
         status, message = "failed", str(exc)
     except KeyboardInterrupt:
-        _ignore_signals()  # a second Ctrl-C must not interrupt the write that records the first
-        cycle = counter.last.cycle if counter.last else (int(state["n"]) if state else 0)
+        previous = _ignore_signals()  # a second Ctrl-C must not interrupt the write that records the first
         try:
+            cycle = counter.last.cycle if counter.last else (int(state["n"]) if state else 0)
             _finish(writer, setup, counter, t0, "interrupted", f"interrupted after cycle {cycle}; resume with "
                                                                f"`fretsim run --resume {output}`")
         except ResultsIOError:
             pass  # the last good flush stays (status 'running'): still resumable
+        finally:
+            _restore_signals(previous)
         raise
     try:
         _finish(writer, setup, counter, t0, status, message)
@@ -235,10 +237,16 @@ def _execute(setup, filled, plan, output, overwrite, progress, observers, resume
                    counter.last, setup.notes, plan, writer is not None)
 
 
-def _ignore_signals() -> None:
-    if threading.current_thread() is threading.main_thread():
-        for sig in (signal.SIGINT, signal.SIGTERM):
-            signal.signal(sig, signal.SIG_IGN)
+def _ignore_signals() -> dict:
+    """Ignore SIGINT and SIGTERM (main thread only); returns the handlers to restore."""
+    if threading.current_thread() is not threading.main_thread():
+        return {}
+    return {sig: signal.signal(sig, signal.SIG_IGN) for sig in (signal.SIGINT, signal.SIGTERM)}
+
+
+def _restore_signals(previous: dict) -> None:
+    for sig, handler in previous.items():
+        signal.signal(sig, handler)
 
 
 def _cycle_on_disk(writer) -> Optional[int]:

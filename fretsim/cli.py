@@ -295,7 +295,7 @@ def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> N
 @click.option("-o", "--outdir", type=click.Path(file_okay=False, path_type=Path),
               help="Directory for the figures (default: next to RESULTS_FILE).")
 @click.option("--format", "fmt", type=click.Choice(["png", "pdf", "svg"]), default="png", show_default=True)
-@click.option("--dpi", type=click.IntRange(50, 1200), default=200, show_default=True)
+@click.option("--dpi", type=click.IntRange(50, 1200), default=150, show_default=True)
 @click.option("--log", "log_cycles", is_flag=True, help="Logarithmic cycle axis for the histories.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
 def plot(results_file: Path, outdir: Path | None, fmt: str, dpi: int, log_cycles: bool, debug: bool) -> None:

@@ -15,7 +15,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.ticker import ScalarFormatter  # noqa: E402
+from matplotlib.ticker import MaxNLocator, ScalarFormatter  # noqa: E402
 
 from fretsim.results import Results  # noqa: E402
 
@@ -74,12 +74,16 @@ def figures(res: Results, log_cycles: bool = False) -> dict:
         out["maps"] = _maps(res)
     for name, fig in out.items():
         fig.suptitle(title_block(res), fontsize=9)
-        if not fig.get_layout_engine():
-            fig.tight_layout()
+        # fixed margins: a layout engine redraws every figure several times (twice the time, measured)
+        rows = len({ax.get_subplotspec().rowspan.start for ax in fig.axes if ax.get_subplotspec()})
+        top = 1 - (0.45 + 0.18 * (1 + title_block(res).count("\n"))) / fig.get_figheight()
+        fig.subplots_adjust(left=0.07 if name != "maps" else 0.05, right=0.97 if name != "maps" else 0.95,
+                            bottom=0.09 if rows > 1 else 0.13, top=top, hspace=0.42,
+                            wspace=0.22 if name != "maps" else 0.08)
     return out
 
 
-def plot_all(res: Results, outdir: str | Path, fmt: str = "png", dpi: int = 200, log_cycles: bool = False) -> list[Path]:
+def plot_all(res: Results, outdir: str | Path, fmt: str = "png", dpi: int = 150, log_cycles: bool = False) -> list[Path]:
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     stem = Path(res.path).stem
@@ -179,19 +183,25 @@ def _maps(res: Results):
     last = len(cycles) - 1
     wear = [res.fields[f"wear_depth_{b}"][last] for b in ("moving", "stationary")]
     vmax = max(float(w.max()) for w in wear) or 1.0
-    fig, axes = plt.subplots(1, 3, figsize=(15, 4.8), layout="constrained")
+    fig = plt.figure(figsize=(15, 4.8))
+    gs = fig.add_gridspec(1, 6, width_ratios=[1, 1, 0.045, 0.28, 1, 0.045], wspace=0.08)
+    axes = [fig.add_subplot(gs[0, i]) for i in (0, 1, 4)]
+    bars = [fig.add_subplot(gs[0, i]) for i in (2, 5)]
     levels = np.linspace(0.0, vmax, 21)
     for ax, body, w in zip(axes[:2], ("moving", "stationary"), wear):
         cs = ax.contourf(res.x, res.y, w, levels=levels, cmap="viridis", extend="neither")
         ax.set_title(f"{body} body wear, {_cycles_label(cycles[last])}")
-    fig.colorbar(cs, ax=list(axes[:2]), label=f"wear depth ({_unit(res, 'fields/wear_depth_moving')}), one scale")
+    axes[1].tick_params(labelleft=False)
+    fig.colorbar(cs, cax=bars[0], label=f"wear depth ({_unit(res, 'fields/wear_depth_moving')}), one scale")
     p = res.fields["pressure"][last]
     pc = axes[2].contourf(res.x, res.y, p, levels=21, cmap="magma")
-    fig.colorbar(pc, ax=axes[2], label=f"contact pressure ({_unit(res, 'fields/pressure')})")
+    fig.colorbar(pc, cax=bars[1], label=f"contact pressure ({_unit(res, 'fields/pressure')})")
     axes[2].set_title(f"pressure on the moving body, {_cycles_label(cycles[last])}")
     for ax in axes:
         ax.set_xlabel("x, sliding direction (mm)")
-        ax.set_ylabel("y (mm)")
+        ax.xaxis.set_major_locator(MaxNLocator(5))
+    axes[0].set_ylabel("y (mm)")
+    axes[2].set_ylabel("y (mm)")
     return fig
 
 
@@ -199,7 +209,7 @@ def _history(res: Results, log_cycles: bool):
     """Maximum depth and wear volume against cycles, a marker at each solve, Archard's volume line."""
     h = res.history
     n = h["cycle"]
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.2))
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.4))
     ax = axes[0]
     for (name, label), ls in zip((("max_wear_depth_total", "total"), ("max_wear_depth_stationary", "stationary"),
                                   ("max_wear_depth_moving", "moving")), STYLES):

@@ -96,7 +96,7 @@ SUMMARY_UNITS = {
     "element_size_x_um": "um", "element_size_y_um": "um", "elements_x": "1", "elements_y": "1",
     "error_estimate_depth": "1", "error_estimate_pressure": "1",
 }
-NAN_SUMMARY = {"element_size_y_um"}  # NaN in 2D by definition
+NAN_SUMMARY = {"element_size_y_um", "stability_limit_linear"}  # NaN in 2D; infinite when nothing wears
 
 
 class ResultsIOError(OSError):

@@ -15,7 +15,7 @@ import re
 # dimension -> {unit spelling: factor to the internal unit}
 UNITS: dict[str, dict[str, float]] = {
     "length": {"km": 1e6, "m": 1e3, "mm": 1.0, "um": 1e-3, "µm": 1e-3, "micron": 1e-3, "nm": 1e-6, "cm": 10.0},
-    "force": {"N": 1.0, "kN": 1e3, "mN": 1e-3},
+    "force": {"N": 1.0, "kN": 1e3, "MN": 1e6, "mN": 1e-3, "uN": 1e-6, "µN": 1e-6},
     "pressure": {"Pa": 1e-6, "kPa": 1e-3, "MPa": 1.0, "GPa": 1e3, "N/mm2": 1.0, "N/mm^2": 1.0},
     "wear_coefficient": {"1/MPa": 1.0, "1/Pa": 1e6, "1/GPa": 1e-3, "mm2/N": 1.0, "mm^2/N": 1.0, "m2/N": 1e6,
                          "m^2/N": 1e6},

@@ -1,0 +1,379 @@
+"""Nothing lost, nothing silently wrong (issue #13): each break found by the attack on the landed CLI, reproduced."""
+import errno
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from click.testing import CliRunner
+from hypothesis import HealthCheck, given, settings, strategies as st
+
+from fretsim.api import load_case, resume, run
+from fretsim.cli import main
+from fretsim.results import read_results
+
+CASES = Path(__file__).resolve().parent.parent / "cases"
+CASE = str(CASES / "mccoll_185N.yaml")
+QUICK = ["--set", "model.dimension=2d", "--set", "loading.cycles=300", "--set", "output.snapshots=[0, 300]"]
+
+
+def fretsim(*args, cwd=None, timeout=120):
+    return subprocess.run([sys.executable, "-m", "fretsim", *args], capture_output=True, text=True, cwd=cwd,
+                          timeout=timeout)
+
+
+# --- exclusive output ---------------------------------------------------------------------------------------------
+
+def _race(tmp_path, k, extra=()):
+    out = tmp_path / f"race{k}.h5"
+    procs = [subprocess.Popen([sys.executable, "-m", "fretsim", "run", CASE, "-o", str(out), *QUICK, *extra],
+                              stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True) for _ in range(2)]
+    codes = [p.wait(timeout=120) for p in procs]
+    return out, codes, [p.stderr.read() for p in procs]
+
+
+@pytest.mark.parametrize("pairs", [pytest.param(4, id="4-pairs"),
+                                   pytest.param(16, id="16-pairs", marks=pytest.mark.slow)])
+def test_two_runs_started_together_on_one_output_exactly_one_wins(tmp_path, pairs):
+    for k in range(pairs):
+        out, codes, errs = _race(tmp_path, k)
+        assert sorted(codes) == [0, 2], (codes, errs)
+        loser = errs[codes.index(2)]
+        assert "another fretsim run is writing" in loser or "exists already" in loser or "appeared" in loser, loser
+        res = read_results(out)
+        assert res.status == "complete" and res.history["cycle"][-1] == 300
+
+
+def test_concurrent_overwriting_runs_never_interleave(tmp_path):
+    for k in range(3):
+        out, codes, errs = _race(tmp_path, k, ("--overwrite",))
+        assert 0 in codes and set(codes) <= {0, 2}, (codes, errs)
+        res = read_results(out)  # one whole run, verified (checksums, shapes)
+        assert res.status == "complete" and len(set(res.history["cycle"])) == len(res.history["cycle"])
+
+
+@pytest.mark.parametrize("output, words", [("case", "is the case file itself"), ("dir/", "is a directory"),
+                                           ("-", "not a file name"), ("missing/x.h5", "does not exist")])
+def test_outputs_that_cannot_be_results_files_are_refused_and_nothing_is_touched(tmp_path, output, words):
+    case = tmp_path / "case.yaml"
+    case.write_text((CASES / "mccoll_185N.yaml").read_text())
+    before = case.read_bytes()
+    (tmp_path / "dir").mkdir()
+    target = str(case) if output == "case" else str(tmp_path / output) if output != "-" else "-"
+    r = CliRunner().invoke(main, ["run", str(case), "-o", target, "--overwrite", *QUICK])
+    assert r.exit_code == 2 and words in r.output, r.output
+    assert case.read_bytes() == before and not (tmp_path / "dir" / "case.h5").exists()
+
+
+def test_long_output_names_work_because_temporaries_are_short(tmp_path):
+    name = "r" * 197 + ".h5"  # 200 bytes: "name.pid.tmp" temporaries used to overflow the 255-byte limit
+    r = CliRunner().invoke(main, ["run", CASE, "-o", str(tmp_path / name), *QUICK])
+    assert r.exit_code == 0, r.output
+    assert sorted(p.name for p in tmp_path.iterdir()) == [name]  # no temporary, no lock left behind
+
+
+# --- I/O failures ---------------------------------------------------------------------------------------------------
+
+@pytest.fixture
+def tiny_disk(tmp_path):
+    mount = tmp_path / "tiny"
+    mount.mkdir()
+    r = subprocess.run(["mount", "-t", "tmpfs", "-o", "size=200k", "tmpfs", str(mount)], capture_output=True)
+    if r.returncode != 0:
+        pytest.skip(f"a size-limited tmpfs needs root and mount rights: {r.stderr.decode().strip()[:80]}")
+    yield mount
+    subprocess.run(["umount", str(mount)], capture_output=True)
+
+
+def test_a_full_disk_ends_the_run_with_exit_5_and_keeps_the_last_good_file(tiny_disk):
+    out = tiny_disk / "out.h5"
+    # a 2D run whose 100 snapshots outgrow 200 kB (a flush needs room for two copies): full in mid-run
+    snaps = ", ".join(str(20 * k) for k in range(101))
+    r = fretsim("run", CASE, "-o", str(out), "--set", "model.dimension=2d", "--set", "loading.cycles=2000",
+                "--set", f"output.snapshots=[{snaps}]")
+    assert r.returncode == 5, r.stderr
+    assert "disk is full" in r.stderr and "--resume" in r.stderr and "Traceback" not in r.stderr
+    assert [p.name for p in tiny_disk.iterdir()] == ["out.h5"]  # no temporary, no lock left behind
+    res = read_results(out)  # the last good flush, verified
+    assert res.status == "running" and res.history["cycle"][-1] < 2000
+
+
+@pytest.mark.parametrize("failing_flush", [1, 2, 3, "final"])
+def test_an_injected_enospc_at_any_flush_leaves_a_valid_file_or_none(tmp_path, monkeypatch, failing_flush):
+    import fretsim.results as results_module
+    real_write = os.write
+    flushes = {"n": 0}
+    real_flush = results_module.ResultsWriter.flush
+
+    def flush(self):
+        flushes["n"] += 1
+        fail = flushes["n"] == failing_flush or (failing_flush == "final" and self.status != "running")
+        if fail:
+            def refuse(fd, data):
+                raise OSError(errno.ENOSPC, "No space left on device")
+            monkeypatch.setattr(results_module.os, "write", refuse)
+        try:
+            return real_flush(self)
+        finally:
+            monkeypatch.setattr(results_module.os, "write", real_write)
+
+    monkeypatch.setattr(results_module.ResultsWriter, "flush", flush)
+    monkeypatch.setattr(results_module, "FLUSH_SECONDS", 0.0)
+    out = tmp_path / "r.h5"
+    outcome = run(load_case(CASE, ["model.dimension=2d", "loading.cycles=2000"]), out)
+    assert outcome.status == "io_error" and "disk is full" in outcome.message
+    assert [p.name for p in tmp_path.iterdir()] == (["r.h5"] if failing_flush != 1 else [])
+    if failing_flush != 1:
+        res = read_results(out)
+        assert res.status == "running"
+        monkeypatch.undo()
+        assert resume(out).status == "complete"
+
+
+# --- resume and interrupts ------------------------------------------------------------------------------------------
+
+def test_a_run_killed_as_it_finished_resumes_to_complete_at_once(tmp_path):
+    out = tmp_path / "r.h5"
+    run(load_case(CASE, ["model.dimension=2d", "loading.cycles=500"]), out)
+    with h5py.File(out, "r+") as f:  # what a kill between the last flush and the final status leaves
+        f.attrs["status"] = "running"
+    before = read_results(out)
+    assert resume(out).status == "complete"
+    after = read_results(out)
+    assert after.status == "complete" and np.array_equal(before.history["cycle"], after.history["cycle"])
+    for cycles in ("0",):  # a contact-only run too
+        out0 = tmp_path / f"c{cycles}.h5"
+        run(load_case(CASE, ["model.dimension=2d", f"loading.cycles={cycles}"]), out0)
+        with h5py.File(out0, "r+") as f:
+            f.attrs["status"] = "interrupted"
+        assert resume(out0).status == "complete"
+
+
+def test_two_ctrl_c_in_quick_succession_leave_a_consistent_interrupted_file(tmp_path):
+    for k in range(3):
+        out = tmp_path / f"i{k}.h5"
+        proc = subprocess.Popen([sys.executable, "-m", "fretsim", "run", CASE, "-o", str(out), "--set",
+                                 "model.dimension=2d", "--set", "jumping.scheme=linear", "--set",
+                                 "loading.cycles=200000"], stdout=subprocess.PIPE, stderr=subprocess.PIPE,
+                                preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
+        deadline = time.monotonic() + 60
+        while not out.exists() and time.monotonic() < deadline:
+            time.sleep(0.02)
+        time.sleep(0.3)
+        proc.send_signal(signal.SIGINT)
+        time.sleep(0.003)
+        proc.send_signal(signal.SIGINT)
+        assert proc.wait(timeout=60) == 130
+        assert read_results(out).status == "interrupted"
+
+
+# --- hostile case files -----------------------------------------------------------------------------------------------
+
+BOMB = ("a0: &a0 [1, 1, 1, 1, 1, 1, 1, 1, 1, 1]\n" + "".join(
+    f"a{i}: &a{i} [{', '.join([f'*a{i - 1}'] * 10)}]\n" for i in range(1, 9)))
+
+
+@pytest.mark.parametrize("text, words", [
+    (BOMB + "name: x\n", "expands to more than"),
+    ("[" * 500, "nested more than"),
+    ("name: x\nloading: {cycles: " + "9" * 400 + "}\n", "out of range"),
+    ("loading: {cycles: 10}\nloading: {cycles: 20}\n", "given twice"),
+    ('name: "a\\0b"\n', "control character"),
+    ("loading: {normal_load: 185 N, stroke: 25 um, cycles: 1:30}\n", "expected a whole number"),
+], ids=["alias-bomb", "deep-nesting", "400-digits", "duplicate-section", "nul-in-name", "sexagesimal"])
+def test_hostile_case_files_are_refused_quickly_with_a_short_message(tmp_path, text, words):
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    t = time.perf_counter()
+    r = CliRunner().invoke(main, ["run", str(path), "-o", str(tmp_path / "o.h5")])
+    assert r.exit_code == 2 and words in r.output and "Traceback" not in r.output, r.output
+    assert time.perf_counter() - t < 5 and len(r.output) < 2000
+    assert not (tmp_path / "o.h5").exists()
+
+
+def test_yaml_1_2_integers_read_as_written():
+    case = load_case(CASE, ["loading.cycles=017"])  # YAML 1.1 read this as octal 15
+    assert case.cycles == 17
+
+
+def test_hostile_overrides_are_refused_like_the_file():
+    r = CliRunner().invoke(main, ["run", CASE, "--set", "loading.cycles=" + "[" * 500])
+    assert r.exit_code == 2 and "nested more than" in r.output and "Traceback" not in r.output
+
+
+@pytest.mark.parametrize("command", [["run", "{f}"], ["run", "--resume", "{f}"], ["summary", "{f}"], ["plot", "{f}"]])
+def test_a_fifo_is_refused_at_once_not_waited_on(tmp_path, command):
+    fifo = tmp_path / "pipe.yaml"
+    os.mkfifo(fifo)
+    r = fretsim(*[c.format(f=fifo) for c in command], cwd=tmp_path, timeout=20)
+    assert r.returncode == 2 and ("FIFO" in r.stderr or "regular" in r.stderr) and "Traceback" not in r.stderr
+
+
+def test_a_huge_case_file_is_refused_before_reading_it(tmp_path):
+    big = tmp_path / "big.yaml"
+    big.write_text("name: x\n" + "# padding\n" * 6_000_000)
+    t = time.perf_counter()
+    r = CliRunner().invoke(main, ["run", str(big)])
+    assert r.exit_code == 2 and "MB" in r.output and time.perf_counter() - t < 2
+
+
+# --- valid cases the solver used to refuse (false convergence on one element) ------------------------------------
+
+@pytest.mark.parametrize("overrides", [
+    ["model.dimension=2d", "loading.stroke=1 nm"], ["model.dimension=2d", "loading.stroke=10 nm"],
+    ["model.dimension=2d", "loading.normal_load=185 kN"], ["model.dimension=2d", "loading.normal_load=10 MN"],
+    ["geometry.radius=1 um", "geometry.length=10 um", "loading.normal_load=1 mN", "loading.stroke=5 nm"],
+], ids=["1nm", "10nm", "185kN", "10MN", "1um-radius-3d"])
+def test_valid_extreme_cases_run_instead_of_being_called_too_coarse(overrides):
+    out = run(load_case(CASE, [*overrides, "loading.cycles=100"]))
+    assert out.status in ("complete", "stopped"), out.message  # a 10 MN flat wears through: a physical limit
+    assert out.summary["archard_volume_error"] < 1e-9
+
+
+def test_a_coarse_grid_of_a_nanometre_is_refused_by_the_memory_check_not_a_traceback():
+    r = CliRunner().invoke(main, ["run", CASE, "--set", "grid.coarse_element=[1 nm, 1 nm]"])
+    assert r.exit_code == 2 and "GiB" in r.output and "Traceback" not in r.output
+
+
+# --- hostile results files ------------------------------------------------------------------------------------------
+
+@pytest.fixture(scope="module")
+def good_file(tmp_path_factory):
+    path = tmp_path_factory.mktemp("good") / "good.h5"
+    run(load_case(CASE, ["model.dimension=2d", "loading.cycles=600"]), path)
+    with h5py.File(path, "r+") as f:
+        f.attrs["status"] = "interrupted"  # resumable, so --resume has a checkpoint to verify
+    return path
+
+
+def _structural(kind: str, f: h5py.File) -> None:
+    if kind == "history-as-dataset":
+        del f["history"]
+        f["history"] = np.arange(3)
+    elif kind == "group-in-history":
+        del f["history/cycle"]
+        f.create_group("history/cycle")
+    elif kind == "group-as-case":
+        del f["case"]
+        f.create_group("case")
+    elif kind == "missing-pressure":
+        del f["fields/pressure"]
+    elif kind == "missing-history-cycle":
+        del f["history/cycle"]
+    elif kind == "array-summary":
+        f["summary"].attrs["cycles"] = np.arange(5)
+    elif kind == "soft-link-loop":
+        del f["fields/pressure"]
+        f["fields/pressure"] = h5py.SoftLink("/fields/pressure")
+    elif kind == "huge-declared":
+        del f["fields/pressure"]
+        f.create_dataset("fields/pressure", shape=(10**10,), dtype="f8", chunks=(1000,))
+    elif kind == "nan-checkpoint":
+        f["checkpoint/p"][0, 0] = np.nan
+    elif kind == "edited-grid":
+        del f["grid/x"]
+        f["grid/x"] = np.linspace(0, 1, 7)
+    elif kind == "zero-scalar":
+        f["checkpoint"].attrs["jump"] = 0.0
+
+
+STRUCTURAL = ["history-as-dataset", "group-in-history", "group-as-case", "missing-pressure", "missing-history-cycle",
+              "array-summary", "soft-link-loop", "huge-declared", "nan-checkpoint", "edited-grid", "zero-scalar"]
+
+
+def _judge(path: Path, tmp_path: Path) -> None:
+    """Every command on a damaged file: exit 0 with a sound result, or exit 2 with a message — never a traceback,
+    never 'complete' from a damaged checkpoint."""
+    for args in (["summary", str(path), "--json"], ["plot", str(path), "-o", str(tmp_path / "plots")],
+                 ["run", "--resume", str(path)]):
+        r = CliRunner().invoke(main, args)
+        assert r.exit_code in (0, 2, 3), (args, r.exit_code, r.output)
+        assert "Traceback" not in r.output and not isinstance(r.exception, (MemoryError, RecursionError))
+        if r.exit_code == 0 and args[0] == "summary":
+            json.loads(r.output)  # strict JSON
+        if r.exit_code == 0 and args[0] == "run":  # resumed: the result must be the genuine run's
+            res = read_results(path)
+            assert res.status == "complete" and res.summary["archard_volume_error"] < 1e-9
+
+
+@pytest.mark.parametrize("kind", STRUCTURAL)
+def test_structurally_damaged_results_files_are_refused_with_the_dataset_named(tmp_path, good_file, kind):
+    path = tmp_path / "bad.h5"
+    path.write_bytes(good_file.read_bytes())
+    with h5py.File(path, "r+") as f:
+        _structural(kind, f)
+    _judge(path, tmp_path)
+    with pytest.raises(ValueError) as info:
+        read_results(path, for_resume=True)
+    assert str(path) in str(info.value)
+
+
+def test_summary_json_is_strict_when_nothing_wears(tmp_path):
+    out = tmp_path / "z.h5"
+    run(load_case(CASE, ["model.dimension=2d", "loading.cycles=100", "materials.moving.wear_coefficient=0 1/MPa",
+                         "materials.stationary.wear_coefficient=0 1/MPa"]), out)
+    r = CliRunner().invoke(main, ["summary", str(out), "--json"])
+    assert r.exit_code == 0 and "Infinity" not in r.output and "NaN" not in r.output
+    json.loads(r.output)
+
+
+@st.composite
+def mutation(draw):
+    kind = draw(st.sampled_from(["flip", "flip", "truncate", "structural"]))
+    if kind == "structural":
+        return ("structural", draw(st.sampled_from(STRUCTURAL)))
+    if kind == "truncate":
+        return ("truncate", draw(st.floats(0.05, 0.99)))
+    return ("flip", draw(st.lists(st.tuples(st.floats(0.0, 0.9999), st.integers(0, 7)), min_size=1, max_size=8)))
+
+
+def _mutate(src: Path, dst: Path, m) -> None:
+    data = bytearray(src.read_bytes())
+    if m[0] == "truncate":
+        dst.write_bytes(bytes(data[:int(m[1] * len(data))]))
+        return
+    if m[0] == "flip":
+        for where, bit in m[1]:
+            data[int(where * len(data))] ^= 1 << bit
+        dst.write_bytes(bytes(data))
+        return
+    dst.write_bytes(bytes(data))
+    with h5py.File(dst, "r+") as f:
+        _structural(m[1], f)
+
+
+def _fuzz(tmp_path, good_file, m):
+    path = tmp_path / "m.h5"
+    _mutate(good_file, path, m)
+    _judge(path, tmp_path)
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(mutation())
+def test_mutated_results_files_never_give_a_traceback_or_a_false_complete(tmp_path, good_file, m):
+    _fuzz(tmp_path, good_file, m)
+
+
+@pytest.mark.slow
+@settings(max_examples=1000, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(mutation())
+def test_mutated_results_files_1000(tmp_path, good_file, m):
+    _fuzz(tmp_path, good_file, m)
+
+
+def test_an_interrupted_run_through_the_api_leaves_the_processs_signal_handling_as_it_was(tmp_path):
+    class Stop:
+        def on_step(self, setup, step):
+            if step.cycle > 0:
+                raise KeyboardInterrupt
+    before = (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM))
+    with pytest.raises(KeyboardInterrupt):
+        run(load_case(CASE, ["model.dimension=2d", "loading.cycles=500"]), tmp_path / "s.h5", observers=(Stop(),))
+    assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before
+    assert read_results(tmp_path / "s.h5").status == "interrupted"

@@ -1,0 +1,215 @@
+"""Results users can open anywhere and figures checked by their data (issue #11)."""
+import ast
+import csv
+import json
+import subprocess
+import sys
+import warnings
+from pathlib import Path
+
+import h5py
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from fretsim.api import load_case, run
+from fretsim.case import parse_case
+from fretsim.cli import main
+from fretsim.plan import prepare
+from fretsim.results import read_results
+
+ROOT = Path(__file__).resolve().parent.parent
+CASE = ROOT / "cases" / "mccoll_185N.yaml"
+
+
+@pytest.fixture(scope="module")
+def results_3d(tmp_path_factory):
+    path = tmp_path_factory.mktemp("r3") / "r3.h5"
+    run(load_case(CASE, ["loading.cycles=1000", "output.snapshots=[0, 500, 1000]"]), path)
+    return path
+
+
+def test_xarray_opens_the_fields_labelled_with_units_and_no_phony_dimensions(results_3d):
+    xr = pytest.importorskip("xarray")
+    pytest.importorskip("h5netcdf")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")  # phony dimensions come with a warning
+        ds = xr.open_dataset(results_3d, engine="h5netcdf", group="fields")
+        hist = xr.open_dataset(results_3d, engine="h5netcdf", group="history")
+        summ = xr.open_dataset(results_3d, engine="h5netcdf", group="summary")
+    w = ds.wear_depth_stationary
+    assert w.dims == ("cycle", "y", "x") and w.attrs["units"] == "um" and ds.x.attrs["units"] == "mm"
+    profile = w.sel(cycle=1000).sel(y=0, method="nearest")
+    res = read_results(results_3d)
+    assert np.array_equal(profile.values, res.fields["wear_depth_stationary"][-1][res.y.size // 2])
+    assert "cycle" in hist.coords and hist.max_pressure.dims == ("step",)
+    assert summ.cycles.attrs["units"] == "cycles" and int(summ.cycles) == 1000
+
+
+def test_to_xarray_gives_the_same_labelled_fields(results_3d):
+    pytest.importorskip("xarray")
+    fields, history = read_results(results_3d).to_xarray()
+    assert fields.pressure.dims == ("cycle", "y", "x") and list(fields.cycle.values) == [0, 500, 1000]
+    assert history.cycle.attrs["units"] == "cycles"
+
+
+def test_inputs_and_overrides_are_recorded_in_the_file_and_in_summary_json(results_3d):
+    res = read_results(results_3d)
+    assert res.inputs["normal_load"] == (185.0, "N") and res.inputs["stroke"] == (25.0, "um")
+    assert res.overrides == ["loading.cycles=1000", "output.snapshots=[0, 500, 1000]"]
+    data = json.loads(CliRunner().invoke(main, ["summary", str(results_3d), "--json"]).output)
+    assert data["inputs"]["moving_wear_coefficient"] == 2e-8 and data["overrides"] == res.overrides
+
+
+def test_summary_of_several_files_as_csv_has_one_row_each_with_inputs(results_3d, tmp_path):
+    other = tmp_path / "o.h5"
+    run(load_case(CASE, ["model.dimension=2d", "loading.cycles=200", "loading.normal_load=150 N"]), other)
+    r = CliRunner().invoke(main, ["summary", str(results_3d), str(other), "--csv"])
+    rows = list(csv.DictReader(r.output.splitlines()))
+    assert [float(row["input_normal_load"]) for row in rows] == [185.0, 150.0]
+    assert rows[1]["overrides"] == "model.dimension=2d loading.cycles=200 loading.normal_load=150 N"
+
+
+def test_export_writes_csv_with_units_in_the_headers(results_3d, tmp_path):
+    r = CliRunner().invoke(main, ["export", str(results_3d), "--csv", str(tmp_path / "csv")])
+    assert r.exit_code == 0, r.output
+    fields = list(csv.reader(open(tmp_path / "csv" / "fields.csv")))
+    assert fields[0][:4] == ["cycle", "x [mm]", "y [mm]", "wear_depth_moving [um]"]
+    res = read_results(results_3d)
+    assert len(fields) - 1 == res.fields["cycle"].size * res.x.size * res.y.size
+
+
+# --- figures, checked by what they draw ----------------------------------------------------------------------------
+
+def test_figures_draw_the_datasets_they_claim(results_3d):
+    from fretsim.plotting import centre_row, figures, hertz_profile
+    res = read_results(results_3d)
+    figs = figures(res)
+    assert set(figs) == {"pressure_profiles", "wear_profiles", "history", "maps"}
+    ax = figs["pressure_profiles"].axes[0]
+    lines = {ln.get_label(): ln.get_ydata() for ln in ax.lines}
+    assert np.allclose(lines["N = 500"], centre_row(res.fields["pressure"][1]))
+    assert np.allclose(lines["Hertz (N = 0)"], hertz_profile(res, res.x))
+    assert ax.get_ylim()[1] < res.fields["pressure"][0].max()  # the unworn peak is cut off, not the worn states
+    wear_ax = figs["wear_profiles"].axes[1]
+    assert np.allclose(wear_ax.lines[-1].get_ydata(), -centre_row(res.fields["wear_depth_stationary"][-1]))
+    hist = figs["history"].axes[0]
+    assert len(hist.lines[0].get_xdata()) == res.history["cycle"].size  # a marker per solve
+    vol = figs["history"].axes[1]
+    archard = [ln for ln in vol.lines if ln.get_label().startswith("Archard")]
+    assert len(archard) == 2 and np.allclose(archard[1].get_ydata()[-1], res.summary["wear_volume_stationary_mm3"])
+    maps = figs["maps"].axes
+    levels = [ax.collections[0].levels if hasattr(ax.collections[0], "levels") else None for ax in maps[:2]]
+    assert levels[0] is not None and np.array_equal(levels[0], levels[1])  # one colour scale for both bodies
+    title = figs["history"].get_suptitle()
+    assert "P = 185 N" in title and "loading.cycles=1000" in title
+
+
+def test_a_contact_only_run_draws_only_what_it_has(tmp_path):
+    from fretsim.plotting import figures
+    out = tmp_path / "c0.h5"
+    run(load_case(CASE, ["model.dimension=2d", "loading.cycles=0"]), out)
+    assert set(figures(read_results(out))) == {"pressure_profiles"}
+
+
+def test_plot_writes_the_format_asked_for(results_3d, tmp_path):
+    r = CliRunner().invoke(main, ["plot", str(results_3d), "-o", str(tmp_path), "--format", "svg", "--dpi", "100",
+                                  "--log"])
+    assert r.exit_code == 0, r.output
+    assert len(list(tmp_path.glob("*.svg"))) == 4
+
+
+# --- a case reference that cannot drift, templates that run ------------------------------------------------------
+
+def test_the_case_reference_page_is_what_the_schema_generates():
+    from fretsim.templates import case_reference_markdown
+    page = ROOT / "docs" / "case-reference.md"
+    assert page.read_text() == case_reference_markdown(), "regenerate: fretsim case-reference > docs/case-reference.md"
+
+
+def test_every_schema_key_is_in_the_reference_and_accepted_by_the_parser():
+    from fretsim.case import GEOMETRY_KEYS, SCHEMA
+    from fretsim.templates import case_reference_markdown
+    page = case_reference_markdown()
+    for section, keys in SCHEMA.items():
+        for key in keys:
+            assert f".{key}`" in page
+    for kind, keys in GEOMETRY_KEYS.items():
+        for key in keys:
+            assert f"`geometry.{key}` ({kind})" in page
+
+
+@pytest.mark.parametrize("kind", ["cylinder_on_flat", "ball_on_flat", "crossed_cylinders", "mccoll_185N"])
+def test_init_templates_run_as_they_are(kind, tmp_path):
+    from fretsim.templates import template_text
+    case = parse_case(template_text(kind), overrides=["loading.cycles=50"])
+    setup, _, _ = prepare(case)
+    assert setup.cycles == 50
+
+
+def test_init_refuses_to_overwrite_and_names_the_choices(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    assert CliRunner().invoke(main, ["init", "ball_on_flat"]).exit_code == 0
+    r = CliRunner().invoke(main, ["init", "ball_on_flat"])
+    assert r.exit_code == 2 and "exists" in r.output
+    r = CliRunner().invoke(main, ["init", "bal_on_flat"])
+    assert r.exit_code == 2 and "did you mean 'ball_on_flat'" in r.output
+
+
+# --- conventions ---------------------------------------------------------------------------------------------------
+
+def test_python_dash_m_fretsim_is_the_command():
+    r = subprocess.run([sys.executable, "-m", "fretsim", "--help"], capture_output=True, text=True, timeout=60)
+    assert r.returncode == 0 and "run" in r.stdout and "check" in r.stdout
+
+
+def test_dimension_is_accepted_in_capitals():
+    assert load_case(CASE, ["model.dimension=2D"]).dimension == "2d"
+
+
+def test_a_format_1_1_file_is_still_read(results_3d, tmp_path):
+    old = tmp_path / "v11.h5"
+    old.write_bytes(results_3d.read_bytes())
+    with h5py.File(old, "r+") as f:  # what the 1.1 writer made: none of 1.2's additions
+        for path in ("inputs", "choices", "history/error_estimate_depth", "history/error_estimate_pressure",
+                     "fields/x", "fields/y"):
+            del f[path]
+        del f["case"].attrs["sha256"]
+        f.attrs["format_version"] = "1.1"
+    res = read_results(old)
+    assert res.summary["cycles"] == 1000 and res.inputs == {}
+
+
+MODULES = ROOT / "fretsim"
+PHYSICS = ["compliance", "geometry", "grid", "jumping", "refine", "sizing", "stability", "solvers", "wear",
+           "simulate", "reference"]
+
+
+def _imports(path: Path) -> set:
+    tree = ast.parse(path.read_text())
+    out = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            out |= {a.name for a in node.names}
+        elif isinstance(node, ast.ImportFrom) and node.module:
+            out.add(node.module)
+    return out
+
+
+def _files(name: str) -> list[Path]:
+    p = MODULES / name
+    return sorted(p.rglob("*.py")) if p.is_dir() else [MODULES / f"{name}.py"]
+
+
+def test_the_layers_keep_their_import_rules():
+    for name in PHYSICS:  # physics takes arrays and numbers: never the case, the CLI, files or plots
+        for f in _files(name):
+            bad = {m for m in _imports(f) if m.split(".")[:2] in (["fretsim", "case"], ["fretsim", "cli"],
+                                                                   ["fretsim", "results"], ["fretsim", "plotting"],
+                                                                   ["fretsim", "api"], ["fretsim", "plan"])}
+            assert not bad, (f, bad)
+    plotting = {m for m in _imports(MODULES / "plotting.py") if m.startswith("fretsim")}
+    assert plotting == {"fretsim.results"}, plotting  # figures read only the results file
+    for f in MODULES.rglob("*.py"):
+        if f.name != "plotting.py":
+            assert not any(m.startswith("matplotlib") for m in _imports(f)), f
