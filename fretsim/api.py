@@ -67,7 +67,9 @@ def inputs_of(case: Case) -> dict:
     g = case.geometry
     values: dict = {"geometry": (g.kind, "", "contact geometry")}
     for key, spec in GEOMETRY_KEYS[g.kind].items():
-        value = getattr(g, key)
+        value = getattr(g, key, None)
+        if value is None or isinstance(value, tuple):  # absent options; a profile table is in /case
+            continue
         values[f"geometry_{key}"] = (value, "mm" if spec.kind == "length" else "", f"geometry {key.replace('_', ' ')}")
     for body in ("moving", "stationary"):
         m = getattr(case, body)

@@ -14,7 +14,10 @@ from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any, Optional
 
-from fretsim.geometry import GEOMETRIES, BallOnFlat, CrossedCylinders, CylinderOnFlat, Geometry
+import numpy as np
+
+from fretsim.geometry import (GEOMETRIES, BallOnFlat, CrossedCylinders, CylinderOnFlat, Geometry, RollerOnFlat,
+                              TubeOnFlat)
 from fretsim.units import UnitError, format_quantity, parse_quantity
 from fretsim.yamlread import YamlProblem, excerpt, loads, read_text
 
@@ -23,7 +26,7 @@ SCHEMES = ("bdf2", "implicit", "linear", "adaptive")
 PRESETS = {"paper": {"scheme": "adaptive", "eta": 0.55, "max": 600, "linear": 55}}
 DIMENSIONS = ("2d", "3d", "auto")
 GAP_MODELS = ("auto", "mid_stroke", "stroke_average")
-CORRECTIONS = ("finite_space", "ring_bending")
+CORRECTIONS = ("ring_bending",)
 MAX_CYCLES = 10**10
 LENGTH_RANGE = (1e-3, 1e4, "1 µm to 10 m")
 REQUIRED = object()
@@ -62,6 +65,25 @@ GEOMETRY_KEYS: dict[str, dict[str, Key]] = {
                                  plausible=LENGTH_RANGE),
         "sliding": Key("choice", "the moving cylinder slides across its axis or along it", "across",
                        choices=("across", "along"))},
+    "tube_on_flat": {
+        "outer_radius": Key("length", "outer radius R_o of the tube (the contact's radius)", REQUIRED,
+                            plausible=LENGTH_RANGE, example="8.75 mm"),
+        "inner_radius": Key("length", "inner radius R_i of the tube (the wall is R_o − R_i)", REQUIRED,
+                            plausible=LENGTH_RANGE, example="7.75 mm"),
+        "length": Key("length", "contact length along the tube's axis (the flat's length)", REQUIRED,
+                      plausible=LENGTH_RANGE, example="12 mm")},
+    "roller_on_flat": {
+        "radius": Key("length", "roller radius R", REQUIRED, plausible=LENGTH_RANGE, example="6 mm"),
+        "length": Key("length", "roller length L along y", REQUIRED, plausible=LENGTH_RANGE, example="10 mm"),
+        "crown_radius": Key("length", "crowning: the axial profile drops by y²/2R_c", None, plausible=LENGTH_RANGE,
+                            example="500 mm"),
+        "edge_radius": Key("length", "edge rounding: beyond flat_length/2 the profile drops by (|y| − l/2)²/2r_e",
+                           None, plausible=LENGTH_RANGE),
+        "flat_length": Key("length", "the straight middle of an edge-rounded roller", None, plausible=LENGTH_RANGE),
+        "profile": Key("text", "a CSV of the axial profile drop: a header `y [unit], drop [unit]`, then rows "
+                               "(relative to the case file; mirrored if given for y ≥ 0 only)", None),
+        "profile_table": Key("table", "the same profile inline: {y: [lengths], drop: [lengths]} (the filled case "
+                                      "carries it, so a results file reruns without the CSV)", None)},
 }
 
 SCHEMA: dict[str, dict[str, Key]] = {
@@ -88,6 +110,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
                                    "model.accuracy", "auto", choices=DIMENSIONS),
         "gap": Key("choice", "how the flat's wear enters the gap: mid_stroke (the paper, Eq. 18), stroke_average "
                              "(stable for any wear coefficients) or auto", "auto", choices=GAP_MODELS),
+        "corrections": Key("corrections", "compliance added to the half-spaces: `auto` (each where its effect "
+                                          "exceeds model.accuracy), `none`, or a list of ring_bending "
+                                          "(tubes, Eq. 23)", "auto"),
         "accuracy": Key("fraction", "largest difference from the full model accepted when `auto` simplifies it",
                         0.01, lo=1e-4, hi=0.5)},
     "solver": {
@@ -156,6 +181,7 @@ class Case:
     friction_coefficient: Optional[float] = None
     dimension: str = "auto"
     gap_model: str = "auto"
+    corrections: object = "auto"  # "auto", "none" or a tuple of CORRECTIONS
     accuracy: float = 0.01
     solver: str = "cg"
     tolerance: float = 1e-5  # contact solver
@@ -185,7 +211,16 @@ class Case:
         g = self.geometry
         geometry: dict = {"type": g.kind}
         for key, spec in GEOMETRY_KEYS[g.kind].items():
+            if key == "profile_table":
+                continue
+            if key == "profile":
+                if getattr(g, "profile_y", None) is not None:  # the table itself: the filled case needs no file
+                    geometry["profile_table"] = {"y": [format_quantity(v, "length") for v in g.profile_y],
+                                                 "drop": [format_quantity(v, "length") for v in g.profile_drop]}
+                continue
             value = getattr(g, key)
+            if value is None:
+                continue
             geometry[key] = format_quantity(value, spec.kind) if spec.kind in ("length",) else value
 
         def mat(m: Material) -> dict:
@@ -214,7 +249,9 @@ class Case:
             "geometry": geometry,
             "materials": {"moving": mat(self.moving), "stationary": mat(self.stationary)},
             "loading": loading,
-            "model": {"dimension": self.dimension, "gap": self.gap_model, "accuracy": self.accuracy},
+            "model": {"dimension": self.dimension, "gap": self.gap_model,
+                      "corrections": list(self.corrections) if isinstance(self.corrections, tuple) else self.corrections,
+                      "accuracy": self.accuracy},
             "solver": {"method": self.solver, "tolerance": self.tolerance},
             "jumping": jumping,
             "grid": grid,
@@ -315,7 +352,7 @@ class _Reader:
         if mapping is None:
             return None
         value = mapping.get(name)
-        if value is None or (value == "auto" and spec.kind not in ("choice", "text")):
+        if value is None or (value == "auto" and spec.kind not in ("choice", "text", "corrections")):
             if spec.default is REQUIRED:
                 self.fail(path, f"missing; expected {_expected(spec)}")
             return None if spec.default is REQUIRED else spec.default
@@ -353,6 +390,35 @@ class _Reader:
                 return None
             vals = [self.value(v, item, f"{path}[{i}]") for i, v in enumerate(value)]
             return None if None in vals else tuple(vals)
+        if kind == "text":
+            if not isinstance(value, str) or not value.strip():
+                self.fail(path, f"expected a text, got {excerpt(value)}")
+                return None
+            return value
+        if kind == "table":
+            ok = isinstance(value, dict) and set(value) == {"y", "drop"} and all(
+                isinstance(value[k], list) and len(value[k]) >= 2 for k in ("y", "drop")) and len(value["y"]) == len(
+                value["drop"])
+            if not ok:
+                self.fail(path, "expected {y: [lengths], drop: [lengths]} of equal length, at least two each")
+                return None
+            length = Key("length", "", positive=False)
+            ys = [self.quantity(v, length, f"{path}.y[{i}]") for i, v in enumerate(value["y"])]
+            ds = [self.quantity(v, length, f"{path}.drop[{i}]") for i, v in enumerate(value["drop"])]
+            if None in ys or None in ds:
+                return None
+            if not (np.diff(ys) > 0).all():
+                self.fail(path, "y must increase")
+                return None
+            return tuple(ys), tuple(ds)
+        if kind == "corrections":
+            if isinstance(value, str) and value.lower() in ("auto", "none"):
+                return value.lower()
+            items = value if isinstance(value, list) else None
+            if items is None or not all(isinstance(v, str) and v in CORRECTIONS for v in items):
+                self.fail(path, f"expected auto, none, or a list of {', '.join(CORRECTIONS)}; got {excerpt(value)}")
+                return None
+            return tuple(sorted(set(items)))
         if kind == "cycle_list":
             if not isinstance(value, list):
                 self.fail(path, "expected a list of cycle numbers, e.g. [1000, 5000, 18000]")
@@ -413,6 +479,36 @@ class _Reader:
         return int(value)
 
 
+def _read_profile(name, source: str, r: "_Reader"):
+    """(y, drop) in mm from a CSV whose header names the units: `y [mm], drop [um]`."""
+    import csv
+    import re
+    from fretsim.units import UNITS
+    path = Path(source).parent / str(name)
+    try:
+        text = read_text(path, "profile file")
+    except (OSError, ValueError) as exc:
+        r.fail("geometry.profile", f"{path}: {exc}")
+        return None, None
+    rows = [row for row in csv.reader(text.splitlines()) if row and not row[0].lstrip().startswith("#")]
+    head = [h.strip() for h in rows[0]] if rows else []
+    units = [re.fullmatch(r"\w+\s*\[(.+)\]", h) for h in head[:2]]
+    if len(head) < 2 or not all(units) or any(u.group(1) not in UNITS["length"] for u in units):
+        r.fail("geometry.profile", f"{path}: the first line must name the columns with length units, e.g. "
+                                   f"'y [mm], drop [um]'")
+        return None, None
+    scale = [UNITS["length"][u.group(1)] for u in units]
+    try:
+        data = np.array([[float(v) for v in row[:2]] for row in rows[1:]])
+    except ValueError as exc:
+        r.fail("geometry.profile", f"{path}: a row is not two numbers ({exc})")
+        return None, None
+    if data.ndim != 2 or len(data) < 2 or not np.isfinite(data).all() or not (np.diff(data[:, 0]) > 0).all():
+        r.fail("geometry.profile", f"{path}: needs at least two rows with increasing y and finite numbers")
+        return None, None
+    return tuple(data[:, 0] * scale[0]), tuple(data[:, 1] * scale[1])
+
+
 def _expected(spec: Key) -> str:
     kind = spec.kind
     if kind in ("length", "force", "pressure", "wear_coefficient"):
@@ -447,7 +543,7 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
     if gtype is not None:
         keys = GEOMETRY_KEYS[gtype]
         for k in geo:
-            if k != "type" and k not in keys:
+            if k != "type" and k not in keys and geo[k] is not None:
                 r.fail(f"geometry.{k}", f"a {gtype} has no {k}; its keys are {', '.join(keys)}")
         vals = {k: r.key(geo, k, spec, f"geometry.{k}") for k, spec in keys.items()}
         if all(v is not None for k, v in vals.items() if keys[k].default is REQUIRED):
@@ -458,6 +554,22 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
             elif gtype == "crossed_cylinders" and vals["sliding"] is not None:
                 geometry = CrossedCylinders(vals["radius"], vals["radius_stationary"] or vals["radius"],
                                             vals["sliding"])
+            elif gtype == "roller_on_flat":
+                table = _read_profile(vals["profile"], source, r) if vals.get("profile") else (
+                    vals["profile_table"] if vals.get("profile_table") else (None, None))
+                if not (vals["crown_radius"] or vals["edge_radius"] or table[0] is not None):
+                    r.fail("geometry", "a roller_on_flat needs a profile: crown_radius, edge_radius (with "
+                                       "flat_length) or profile (a CSV file)")
+                elif vals["edge_radius"] and vals["flat_length"] is None:
+                    r.fail("geometry.flat_length", "an edge-rounded roller needs the length of its straight middle")
+                elif table[0] is not None or not vals.get("profile"):
+                    geometry = RollerOnFlat(vals["radius"], vals["length"], vals["crown_radius"],
+                                            vals["edge_radius"], vals["flat_length"], *table)
+            elif gtype == "tube_on_flat":
+                if vals["inner_radius"] >= vals["outer_radius"]:
+                    r.fail("geometry.inner_radius", "must be smaller than geometry.outer_radius")
+                else:
+                    geometry = TubeOnFlat(vals["outer_radius"], vals["inner_radius"], vals["length"])
 
     mats = r.section(raw, "materials", {"moving", "stationary"})
     materials = {}
@@ -517,7 +629,8 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
     return Case(name=name, geometry=geometry, moving=materials["moving"], stationary=materials["stationary"],
                 normal_load=load["normal_load"], stroke=stroke, cycles=load["cycles"],
                 friction_coefficient=load.get("friction_coefficient"), dimension=dimension,
-                gap_model=model["gap"], accuracy=model["accuracy"], solver=solver["method"],
+                gap_model=model["gap"], corrections=model["corrections"], accuracy=model["accuracy"],
+                solver=solver["method"],
                 tolerance=solver["tolerance"], scheme=scheme, step_tolerance=jumping["tolerance"],
                 linear_jump=jumping.get("linear") if scheme in ("linear", "adaptive") else jumping.get("linear"),
                 eta=jumping["eta"], max_jump=jumping.get("max"), preset=preset, coarse_element=coarse,

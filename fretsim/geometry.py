@@ -189,4 +189,95 @@ class CrossedCylinders(Geometry):
         return _cap_half_widths(volume, *self.radii_xy)
 
 
-GEOMETRIES: dict[str, type] = {g.kind: g for g in (CylinderOnFlat, BallOnFlat, CrossedCylinders)}
+@dataclass(frozen=True)
+class TubeOnFlat(Geometry):
+    """A tube (outer radius R_o, inner R_i), axis along y, on a flat of length L (steam-generator tube and its
+    support, paper section 4.3, Fig. 26).  The gap is the cylinder's (Eq. 9) with R_o over the flat's length; the
+    tube wall also bends as a ring (:class:`~fretsim.compliance.ring.RingBending`, Eq. 23), and is worn through
+    at the wall thickness."""
+
+    kind: ClassVar[str] = "tube_on_flat"
+    outer_radius: float
+    inner_radius: float
+    length: float
+
+    @property
+    def line_length(self) -> float:
+        return self.length
+
+    @property
+    def wall(self) -> float:
+        return self.outer_radius - self.inner_radius
+
+    def separation(self, grid: Grid) -> np.ndarray:
+        return _line_gap(grid, self.outer_radius, self.length)
+
+    def hertz(self, load: float, e_star: float) -> HertzEstimate:
+        h = hertz_line(load / self.length, self.outer_radius, e_star)
+        return HertzEstimate(h.half_width, self.length / 2, h.peak_pressure, True)
+
+    @property
+    def limits(self) -> Limits:
+        return Limits(self.wall, self.outer_radius / 2, None, f"the tube's wall thickness {self.wall:.4g} mm "
+                                                              f"(the tube leaks)")
+
+    def scar_half_widths(self, volume: float) -> tuple[float, float]:
+        return (1.5 * self.outer_radius * volume / self.length) ** (1 / 3), self.length / 2
+
+    def extra_compliance(self, grid: Grid, youngs_modulus: float, poissons_ratio: float):
+        from fretsim.compliance.ring import RingBending
+        return RingBending(grid, self.outer_radius, self.inner_radius, youngs_modulus, poissons_ratio)
+
+
+@dataclass(frozen=True)
+class RollerOnFlat(Geometry):
+    """A roller of radius R and length L whose axial profile drops by d(y) from the middle: crowned (a crown
+    radius: d = y²/2R_c), edge-rounded (flat over a middle length, then circular: d = (|y| − l/2)²/2r_e), or
+    tabulated (d at points along y, interpolated linearly, mirrored if given for y ≥ 0 only) — what designers
+    optimise against the finite cylinder's end peaks.  Gap: x²/2R + d(y) (Eq. 9 plus the profile)."""
+
+    kind: ClassVar[str] = "roller_on_flat"
+    radius: float
+    length: float
+    crown_radius: Optional[float] = None
+    edge_radius: Optional[float] = None
+    flat_length: Optional[float] = None
+    profile_y: Optional[tuple] = None  # mm
+    profile_drop: Optional[tuple] = None  # mm
+
+    @property
+    def line_length(self) -> float:
+        return self.length
+
+    def drop(self, y: np.ndarray) -> np.ndarray:
+        y = np.abs(np.asarray(y, dtype=float))
+        d = np.zeros_like(y)
+        if self.crown_radius:
+            d = d + y**2 / (2 * self.crown_radius)
+        if self.edge_radius:
+            flat = 0.5 * (self.flat_length if self.flat_length is not None else 0.0)
+            d = d + np.clip(y - flat, 0.0, None) ** 2 / (2 * self.edge_radius)
+        if self.profile_y is not None:
+            py, pd = np.asarray(self.profile_y), np.asarray(self.profile_drop)
+            if py.min() >= 0:
+                py, pd = np.concatenate([-py[::-1], py]), np.concatenate([pd[::-1], pd])
+            d = d + np.interp(y, py, pd)
+        return d
+
+    def separation(self, grid: Grid) -> np.ndarray:
+        return _line_gap(grid, self.radius, self.length, None if grid.plane_strain else self.drop(grid.y))
+
+    def hertz(self, load: float, e_star: float) -> HertzEstimate:
+        h = hertz_line(load / self.length, self.radius, e_star)
+        return HertzEstimate(h.half_width, self.length / 2, h.peak_pressure, True)
+
+    @property
+    def limits(self) -> Limits:
+        return Limits(self.radius, self.radius / 2, None, f"its radius {self.radius:.4g} mm")
+
+    def scar_half_widths(self, volume: float) -> tuple[float, float]:
+        return (1.5 * self.radius * volume / self.length) ** (1 / 3), self.length / 2
+
+
+GEOMETRIES: dict[str, type] = {g.kind: g for g in (CylinderOnFlat, BallOnFlat, CrossedCylinders, TubeOnFlat,
+                                                    RollerOnFlat)}

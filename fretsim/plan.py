@@ -15,10 +15,11 @@ from typing import Any, Optional
 import numpy as np
 
 from fretsim.case import PRESETS, Case, CaseError
-from fretsim.compliance import HalfSpace
+from fretsim.compliance import HalfSpace, Sum, add
+from fretsim.geometry import TubeOnFlat
 from fretsim.grid import Grid
 from fretsim.reference import effective_modulus
-from fretsim.simulate import Setup
+from fretsim.simulate import Setup, SimulationError
 from fretsim.sizing import Sizing, auto_grid
 from fretsim.stability import Spectrum, default_linear_jump, wear_spectrum
 from fretsim.wear import stroke_reach, stroke_symbol, wear_operator
@@ -72,38 +73,58 @@ def memory_estimate(elements: int, snapshots: int, solver: str, coarse_elements:
 # --- the choices ----------------------------------------------------------------------------------------------
 
 def choose_dimension(case: Case, e_star: float) -> Choice:
-    """2d or 3d.  auto: the cheapest whose centre line is within model.accuracy of the full 3D model.
+    """2d or 3d.  auto: 2D where it reports the quantities of the full 3D model within model.accuracy.
 
-    The estimate is the share of P/L the 3D centre line carries at the start (one contact solve on the 3D
-    grid): end effects take the rest, most at the start (wear evens them out), and the centre-line wear
-    follows that share.  Point contacts have no 2D model.
+    Estimated before the run by proxy runs on a coarse grid (half the x resolution, 15 rows): the case in 2D
+    and in 3D, compared on the maximum depth of each body, the flat's centre-line depth and both scar widths
+    (the peak pressure for a contact-only run).  The unworn contact alone is no guide: a flat-ended cylinder's
+    ends draw load from its whole length (its centre line carries 93-96 % of P/L for L/a from 280 to 8300,
+    falling off as 1/ln(L/a)), but wear evens that out; and a profiled roller may start balanced and end not.
+    Point contacts have no 2D model.
     """
     g = case.geometry
     if case.dimension != "auto":
         return Choice("model.dimension", case.dimension, "given in the case", True)
     if not g.has_2d:
         return Choice("model.dimension", "3d", f"a {g.kind} is a point contact: it has no 2D model")
-    share = centre_line_share(case, e_star)
-    off = abs(1.0 - share)
-    if off <= case.accuracy:
-        return Choice("model.dimension", "2d", f"the 3D centre line carries {share:.2%} of P/L at the start, "
-                                               f"{off:.2%} from 2D, within model.accuracy {case.accuracy:.2%}: 2D "
-                                               f"(end effects, which 2D leaves out, are small)")
-    return Choice("model.dimension", "3d", f"the 3D centre line carries {share:.2%} of P/L at the start (end "
-                                           f"effects take the rest): 2D would be {off:.2%} off, more than "
-                                           f"model.accuracy {case.accuracy:.2%}")
+    try:
+        diff, what = _dimension_proxy(case, e_star)
+    except SimulationError as exc:
+        return Choice("model.dimension", "3d", f"the full model: a proxy run to judge 2D stopped "
+                                               f"({str(exc)[:120]}…)")
+    if diff <= case.accuracy:
+        return Choice("model.dimension", "2d", f"a coarse 3D proxy run reports {what} within {diff:.2%} of 2D, "
+                                               f"inside model.accuracy {case.accuracy:.2%}: 2D (the ends' effect "
+                                               f"on the reported quantities is small)")
+    return Choice("model.dimension", "3d", f"a coarse 3D proxy run reports {what} {diff:.2%} away from 2D, "
+                                           f"more than model.accuracy {case.accuracy:.2%}: the ends matter, 3D")
 
 
-def centre_line_share(case: Case, e_star: float) -> float:
-    """Share of the line load P/L the centre line of the unworn 3D contact carries (one solve)."""
-    from fretsim.simulate import centre_line
-    from fretsim.solvers import solve
+PROXY_ROWS = 15
+
+
+def _dimension_proxy(case: Case, e_star: float) -> tuple[float, str]:
+    from fretsim.simulate import simulate, summarize
     g = case.geometry
-    sizing = auto_grid(g, False, case.normal_load, case.stroke, 0, 0.0, e_star)
-    nx, ny = sizing.elements
-    grid = Grid.centred(nx, ny, sizing.domain[0] / nx, sizing.domain[1] / ny)
-    res = solve(HalfSpace(grid, e_star), g.separation(grid), case.normal_load, tol=1e-8)
-    return float(centre_line(res.pressure).sum() * grid.dx / (case.normal_load / g.line_length))
+    k = case.moving.wear_coefficient + case.stationary.wear_coefficient
+    sizing = auto_grid(g, False, case.normal_load, case.stroke, case.cycles, k, e_star)
+    nx = max(21, (sizing.elements[0] // 2) | 1)
+    keys = (("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "centre_wear_depth_stationary_um",
+             "scar_width_moving_mm", "scar_width_stationary_mm") if case.cycles else ("max_pressure_MPa",))
+    out = []
+    for dim, domain, elements in (("2d", sizing.domain[:1], (nx,)), ("3d", sizing.domain, (nx, PROXY_ROWS))):
+        proxy = case.with_choices(dimension=dim, snapshots=(case.cycles,), domain=domain, elements=elements,
+                                  coarse_element=None, linear_jump=None, scheme="bdf2", preset=None,
+                                  step_tolerance=max(case.step_tolerance, 0.03))
+        setup, _, _ = prepare(proxy)
+        out.append(summarize(setup, simulate(setup), 0, 0.0))
+    diffs = {key: abs(out[1][key] / out[0][key] - 1) if out[0][key] else 0.0 for key in keys}
+    worst = max(diffs, key=diffs.get)
+    names = {"max_wear_depth_moving_um": "the moving body's maximum depth", "max_wear_depth_stationary_um":
+             "the flat's maximum depth", "centre_wear_depth_stationary_um": "the flat's centre-line depth",
+             "scar_width_moving_mm": "the moving body's scar width", "scar_width_stationary_mm":
+             "the flat's scar width", "max_pressure_MPa": "the peak pressure"}
+    return diffs[worst], names[worst]
 
 
 def choose_grid(case: Case, plane: bool, sizing: Sizing) -> tuple[Choice, Choice]:
@@ -139,6 +160,60 @@ def choose_gap_model(case: Case, grid: Grid) -> Choice:
                   f"{-b_min:.3f} of the flat (k_m = {k_m:.3g}, k_s = {k_s:.3g} 1/MPa): wear modes shorter than "
                   f"the stroke grow in the model itself and break the pressure into spikes; the flat's wear seen "
                   f"through the stroke average is stable and equal to first order")
+
+
+def choose_corrections(case: Case, grid: Grid, e_star: float, scar_half_width: float) -> Choice:
+    """Compliance added to the half-spaces (the tube's ring bending).  auto: each correction whose effect on the
+    reported quantities exceeds model.accuracy.  Estimated before the run by two quick 2D proxy runs of the case,
+    with and without it, compared on the maximum depths and scar widths of both bodies (the pressure of the
+    unworn contact for a contact-only run).  A static estimate is not enough: in steady fretting wear the
+    pressure follows from the wear (a nearly even wear rate across the contact), not from the compliance, so a
+    correction that reshapes the pressure of a given worn shape may change the wear very little."""
+    g = case.geometry
+    available = ("ring_bending",) if isinstance(g, TubeOnFlat) else ()
+    if case.corrections != "auto":
+        chosen = () if case.corrections == "none" else tuple(case.corrections)
+        for c in chosen:
+            if c not in available:
+                raise CaseError(case.source, [("model.corrections", f"{c} does not apply to a {g.kind}; available: "
+                                                                    f"{', '.join(available) or 'none'}")])
+        return Choice("model.corrections", chosen, "given in the case", True)
+    if not available:
+        return Choice("model.corrections", (), f"none applies to a {g.kind}: both bodies are half-spaces")
+    try:
+        diff, what = _proxy_difference(case, ("ring_bending",))
+    except SimulationError as exc:
+        return Choice("model.corrections", ("ring_bending",), f"kept: a 2D proxy run to judge it stopped "
+                                                              f"({str(exc)[:120]}…)")
+    if diff > case.accuracy:
+        return Choice("model.corrections", ("ring_bending",),
+                      f"the tube wall's ring bending (Eq. 23) changes {what} by {diff:.1%} in a 2D proxy run, more "
+                      f"than model.accuracy {case.accuracy:.1%}")
+    return Choice("model.corrections", (), f"the tube wall's ring bending (Eq. 23) changes {what} by only "
+                                           f"{diff:.2%} in a 2D proxy run, within model.accuracy "
+                                           f"{case.accuracy:.1%}: in steady wear the pressure follows the wear, not "
+                                           f"the wall's compliance; left out (set model.corrections to include it)")
+
+
+def _proxy_difference(case: Case, corrections: tuple) -> tuple[float, str]:
+    """Largest relative difference of the reported quantities between 2D runs without and with ``corrections``."""
+    from fretsim.simulate import simulate, summarize
+    keys = (("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "scar_width_moving_mm",
+             "scar_width_stationary_mm") if case.cycles else ("max_pressure_MPa",))
+    out = []
+    for corr in ((), corrections):
+        proxy = case.with_choices(dimension="2d", corrections=corr or "none", snapshots=(case.cycles,),
+                                  domain=None, elements=None, coarse_element=None, linear_jump=None,
+                                  scheme="bdf2", preset=None)
+        setup, _, _ = prepare(proxy)
+        last = simulate(setup)
+        out.append(summarize(setup, last, 0, 0.0))
+    diffs = {k: abs(out[1][k] / out[0][k] - 1) if out[0][k] else 0.0 for k in keys}
+    worst = max(diffs, key=diffs.get)
+    names = {"max_wear_depth_moving_um": "the moving body's maximum depth", "max_wear_depth_stationary_um":
+             "the flat's maximum depth", "scar_width_moving_mm": "the moving body's scar width",
+             "scar_width_stationary_mm": "the flat's scar width", "max_pressure_MPa": "the peak pressure"}
+    return diffs[worst], names[worst]
 
 
 def choose_scheme(case: Case) -> Choice:
@@ -209,6 +284,9 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
     dimension = plan.add(choose_dimension(case, e_star))
     plane = dimension == "2d"
     sizing = auto_grid(g, plane, case.normal_load, case.stroke, case.cycles, k_m + k_s, e_star)
+    gap_probe = choose_gap_model(case, Grid.centred(3, 1, sizing.domain[0] / sizing.elements[0], 1.0, True))
+    if gap_probe.value == "stroke_average":  # its wear reaches two strokes beyond the contact
+        sizing = auto_grid(g, plane, case.normal_load, case.stroke, case.cycles, k_m + k_s, e_star, strokes=2)
     c_domain, c_elements = choose_grid(case, plane, sizing)
     domain, elements = plan.add(c_domain), plan.add(c_elements)
     if len(domain) < (1 if plane else 2) or len(elements) < (1 if plane else 2):
@@ -226,6 +304,8 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
         cny = 1 if plane else max(1, int(round(domain[1] / case.coarse_element[1])))
         coarse_n = cnx * cny
     need = memory_estimate(nx * ny, len(snapshots) + 5, case.solver, coarse_n)
+    if isinstance(g, TubeOnFlat) and case.corrections != "none":
+        need += 8.0 * nx * nx  # the ring-bending matrix along x
     if need > MEMORY_SHARE * available_memory():
         problems.append(("grid", f"the grid of {nx} x {ny} elements{' (automatic)' if case.elements is None else ''}"
                                  f"{f' solved on {coarse_n} coarse elements' if coarse_n else ''} with solver "
@@ -258,7 +338,16 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
         plan.add(Choice("grid.coarse_element", case.coarse_element, f"given: contact solved on {cnx} x {cny} "
                                                                     f"elements, pressure refined to {nx} x {ny} "
                                                                     f"(Akima weights, Eqs. 11-12)", True))
-    compliance = HalfSpace(grid, e_star)
+    corrections = plan.add(choose_corrections(case, grid, e_star, sizing.scar_half_width))
+
+    def operator(on: Grid):
+        extra = [g.extra_compliance(on, case.moving.youngs_modulus, case.moving.poissons_ratio)
+                 for c in corrections if c == "ring_bending"]
+        return add(HalfSpace(on, e_star), *extra)
+
+    compliance = operator(grid)
+    if coarse is not None:
+        coarse_op = operator(coarse)
     solve_op = coarse_op if coarse_op is not None else compliance
     spectrum = wear_spectrum(solve_op, case.stroke, k_m, k_s, gap_model)
     limit = spectrum.limit
@@ -301,7 +390,8 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
                   coarse_compliance=coarse_op, coarse_gap=coarse_gap, per_cycle=per_cycle,
                   notes=tuple(f"{c.key} = {_show(c.value)}: {c.reason}" for c in plan.choices if not c.given)
                   + tuple(plan.warnings))
-    filled = case.with_choices(dimension=dimension, domain=tuple(domain[:1] if plane else domain[:2]),
+    filled = case.with_choices(dimension=dimension, corrections=corrections or "none",
+                               domain=tuple(domain[:1] if plane else domain[:2]),
                                elements=(nx,) if plane else (nx, ny), gap_model=gap_model, scheme=scheme,
                                linear_jump=jump, max_jump=max_jump, snapshots=snapshots)
     return setup, filled, plan

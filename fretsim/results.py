@@ -441,6 +441,13 @@ class _Damaged(ValueError):
     pass
 
 
+def _name(key, where: str) -> str:
+    """A dataset or attribute name as written by this tool: a plain identifier (a damaged name is refused)."""
+    if not isinstance(key, str) or not key.replace("_", "a").isalnum() or not key.isascii():
+        raise _Damaged(f"{where}: an entry has a damaged name {str(key)[:40]!r}")
+    return key
+
+
 def _regular_file(path: str | Path) -> None:
     try:
         st = os.stat(path)
@@ -547,6 +554,7 @@ def _read(f, path: str, for_resume: bool) -> Results:
         units[f"fields/{k}"] = _text(fl[k].attrs.get("units", ""))
     summary = {}
     for k, v in _group(f, "summary").attrs.items():
+        k = _name(k, "/summary")
         if k == "units":
             continue
         v = _plain(v)
@@ -568,6 +576,7 @@ def _read(f, path: str, for_resume: bool) -> Results:
     if "inputs" in f:
         g = _group(f, "inputs")
         for k, ds in g.items():
+            k = _name(k, "/inputs")
             if isinstance(ds, h5py.Dataset) and ds.shape == ():
                 value = ds[()]
                 inputs[k] = (_text(value) if isinstance(value, bytes) else _plain(value), _text(ds.attrs.get("units", "")))
@@ -584,6 +593,7 @@ def _read_checkpoint(f, shape: tuple) -> dict:
     c = _group(f, "checkpoint")
     state: dict = {}
     for k, ds in c.items():
+        k = _name(k, "/checkpoint")
         if not isinstance(ds, h5py.Dataset):
             raise _Damaged(f"/checkpoint/{k}: expected a dataset")
         data = _dataset(f, f"checkpoint/{k}")
@@ -594,6 +604,7 @@ def _read_checkpoint(f, shape: tuple) -> dict:
         state[k] = data
     digest = None
     for k, v in c.attrs.items():
+        k = _name(k, "/checkpoint")
         if k == "sha256":
             digest = _text(v)
         elif k.endswith("_empty"):

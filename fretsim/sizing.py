@@ -38,8 +38,10 @@ def _odd(n: float) -> int:
 
 
 def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float, cycles: int, k_total: float,
-              e_star: float) -> Sizing:
-    """The paper's element size and a domain holding the estimated final scar (both bodies' volume)."""
+              e_star: float, strokes: int = 1) -> Sizing:
+    """The paper's element size and a domain holding the estimated final scar (both bodies' volume), plus
+    ``strokes`` stroke amplitudes along x (the flat's wear reaches one stroke beyond the contact; seen through
+    the stroke average, two)."""
     h = geometry.hertz(load, e_star)
     a = h.half_width_x
     volume = k_total * load * 4 * stroke * cycles
@@ -48,7 +50,7 @@ def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float
     limits = geometry.limits
     scar_x = min(scar_x, 2 * limits.reach_x)
     dx = 7 * a / ELEMENTS_OVER_7A
-    reach = SCAR_MARGIN * max(scar_x, a) + stroke + 3 * dx
+    reach = SCAR_MARGIN * max(scar_x, a) + strokes * stroke + 3 * dx
     nx = _odd(2 * reach / dx)
     note = (f"dx = 7a/40 = {dx * 1e3:.3g} µm (a = {a * 1e3:.3g} µm), x extent {nx * dx:.3g} mm for an estimated "
             f"scar half-width {scar_x:.3g} mm")

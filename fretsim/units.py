@@ -68,4 +68,4 @@ def example(dimension: str) -> str:
 
 def format_quantity(value: float, dimension: str) -> str:
     """Inverse of :func:`parse_quantity` in the internal unit (used to write the filled case)."""
-    return f"{value!r} {INTERNAL[dimension]}"  # repr round-trips exactly: a resumed run rebuilds the same grid
+    return f"{float(value)!r} {INTERNAL[dimension]}"  # repr round-trips exactly: a resumed run rebuilds the same grid

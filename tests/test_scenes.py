@@ -1,0 +1,179 @@
+"""Every scene of the paper with the model it needs (issue #8): elliptical Hertz, crossed cylinders, two
+materials, the tube's ring bending, profiled rollers, and the choices `auto` makes."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from fretsim.api import load_case, run
+from fretsim.cli import main
+from fretsim.compliance import HalfSpace
+from fretsim.compliance.ring import RingBending, chord_flexibility, ring_rigidity
+from fretsim.grid import Grid
+from fretsim.plan import prepare
+from fretsim.reference import effective_modulus, hertz_elliptical
+from fretsim.solvers import solve
+
+CASES = Path(__file__).resolve().parent.parent / "cases"
+SHIPPED = sorted(p.stem for p in CASES.glob("*.yaml"))
+E_STAR = effective_modulus(2.1e5, 0.3, 2.1e5, 0.3)
+
+
+# --- Hertz's elliptical contact, crossed cylinders of unequal radii ---------------------------------------------
+
+def _elliptical(n: int, rx=1.0, ry=3.0, load=5.0):
+    h = hertz_elliptical(load, rx, ry, E_STAR)
+    grid = Grid.centred(n, n, 3.0 * h.ax / n, 3.0 * h.ay / n)  # elements elongated like the ellipse
+    X, Y = grid.mesh()
+    res = solve(HalfSpace(grid, E_STAR), X**2 / (2 * rx) + Y**2 / (2 * ry), load, tol=1e-12)
+    p = res.pressure
+    # semi-axes from second moments: for Hertz, ∫x²p / ∫p = a²/5 (smooth, so free of the pixelated edge)
+    ax = np.sqrt(5 * (X**2 * p).sum() / p.sum())
+    ay = np.sqrt(5 * (Y**2 * p).sum() / p.sum())
+    return h, np.array([ax / h.ax - 1, ay / h.ay - 1, p.max() / h.peak_pressure - 1, res.approach / h.approach - 1])
+
+
+def test_crossed_cylinders_of_unequal_radii_converge_to_elliptical_hertz_at_second_order():
+    errors = np.array([_elliptical(n)[1] for n in (48, 96, 192)])
+    rates = np.log2(np.abs(errors[:-1]) / np.abs(errors[1:]))
+    assert (np.abs(errors[-1]) < 1e-4).all(), errors  # semi-axes, peak pressure, approach at 192 × 192
+    assert (rates[-1] > 1.8).all(), rates  # second order between the finest grids (measured 1.93-2.00)
+
+
+def test_crossed_cylinders_of_equal_radii_are_a_ball_of_that_radius():
+    base = ["loading.cycles=300", "output.snapshots=[300]"]
+    wire = run(load_case(CASES / "wire_rope.yaml", base))
+    ball = run(load_case(CASES / "wire_rope.yaml", [*base, "geometry.type=ball_on_flat",
+                                                    "geometry.radius_stationary=", "geometry.sliding="]))
+    for key in ("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "max_pressure_MPa"):
+        assert wire.summary[key] == pytest.approx(ball.summary[key], rel=1e-12)
+
+
+def test_the_seat_rails_flat_scar_is_drawn_out_by_the_stroke_and_the_balls_is_round():
+    out = run(load_case(CASES / "seat_rail.yaml", ["loading.cycles=1000"]))
+    g = out.setup.grid
+    X, Y = g.mesh()
+    worn_s = out.last.wear_stationary > 0.01 * out.last.wear_stationary.max()
+    worn_m = out.last.wear_moving > 0.01 * out.last.wear_moving.max()
+    ratio_s = np.ptp(X[worn_s]) / np.ptp(Y[worn_s])
+    ratio_m = np.ptp(X[worn_m]) / np.ptp(Y[worn_m])
+    assert ratio_s > 1.1 * ratio_m and abs(ratio_m - 1) < 0.1, (ratio_s, ratio_m)  # paper Figs. 24-25
+    assert out.summary["archard_volume_error"] < 1e-9
+
+
+# --- the tube's ring bending (Eq. 23) ------------------------------------------------------------------------------
+
+def test_ring_bending_reproduces_the_classical_thin_ring_under_diametral_load():
+    # Roark: the diameter along a pair of loads P shortens by (π/4 − 2/π) P R³ / (E I)
+    r, d = 8.25, 3.7
+    assert chord_flexibility(np.array([0.0]), r, d)[0, 0] == pytest.approx((np.pi / 4 - 2 / np.pi) * r**3 / d,
+                                                                            rel=1e-12)
+
+
+def test_ring_bending_closed_form_matches_a_quadrature_of_the_strain_energy():
+    r, d, psis = 8.25, 1.0, np.array([0.0, 0.03, 0.11, -0.07])
+    closed = chord_flexibility(psis, r, d)
+    psi = np.linspace(-np.pi, np.pi, 200_001)
+    w = np.gradient(psi)
+
+    def moment(pj):  # sampled independently: released moment, then the three compatibility projections
+        pb = np.pi - pj if pj >= 0 else -np.pi - pj
+        m = sum(np.where(psi > pk, f * r * (np.sin(pk) - np.sin(psi)), 0.0) for pk, f in ((pj, 1.0), (pb, -1.0)))
+        for basis, norm in ((np.ones_like(psi), 2 * np.pi), (np.sin(psi), np.pi), (np.cos(psi), np.pi)):
+            m = m - basis * (m * basis * w).sum() / norm
+        return m
+
+    moments = [moment(p) for p in psis]
+    quad = np.array([[r * (mi * mj * w).sum() / d for mj in moments] for mi in moments])
+    assert np.abs(closed - quad).max() <= 1e-4 * np.abs(closed).max()  # quadrature error of the kinks, measured 1e-5
+
+
+def test_ring_bending_operator_is_symmetric_and_stores_energy():
+    grid = Grid.centred(41, 3, 0.01, 4.0)
+    op = RingBending(grid, 8.75, 7.75, 2.11e5, 0.29)
+    m = op.dense()
+    assert np.allclose(m, m.T, rtol=0, atol=1e-14 * np.abs(m).max())
+    assert np.linalg.eigvalsh(m).min() > -1e-12 * np.abs(m).max()  # Maxwell and a positive strain energy
+    assert ring_rigidity(8.75, 7.75, 2.11e5, 0.29) == pytest.approx(2.11e5 / 12 / (1 - 0.29**2))
+
+
+def test_the_tube_wears_through_its_wall_and_stops_with_exit_4(tmp_path):
+    r = CliRunner().invoke(main, ["run", str(CASES / "tube_RT.yaml"), "-o", str(tmp_path / "t.h5"), "--set",
+                                  "model.dimension=2d", "--set", "materials.moving.wear_coefficient=1e-4 1/MPa",
+                                  "--set", "loading.cycles=10000000", "--set", "model.corrections=none"])
+    assert r.exit_code == 4 and "wall thickness" in r.output, r.output
+
+
+def test_the_tubes_90C_to_RT_ratios_match_the_papers():
+    # Kong et al. §4.3: +76 % maximum tube depth and +59 % wear width from RT to 90 °C.  The width is within 10 %:
+    # the paper does not say how it measured it; ours is the worn width of the tube's centre line at 0.1 % of
+    # its maximum depth, interpolated
+    rt, hot = (run(load_case(CASES / f"tube_{t}.yaml", ["model.dimension=2d"])).summary for t in ("RT", "90C"))
+    assert hot["max_wear_depth_moving_um"] / rt["max_wear_depth_moving_um"] == pytest.approx(1.76, rel=0.02)
+    assert hot["scar_width_moving_mm"] / rt["scar_width_moving_mm"] == pytest.approx(1.59, rel=0.10)
+
+
+# --- profiles ---------------------------------------------------------------------------------------------------
+
+def test_relieving_a_rollers_ends_lowers_its_end_peaks_against_its_centre():
+    def excess(case):
+        p = run(case).last.pressure
+        return p.max() / p[p.shape[0] // 2].max()  # the end peak over the centre line's peak
+    plain = excess(load_case(CASES / "mccoll_185N.yaml", ["loading.cycles=0"]))
+    rounded = excess(load_case(CASES / "roller_edge_rounded.yaml", ["loading.cycles=0", "model.dimension=3d",
+                                                                    "geometry.edge_radius=500 mm",
+                                                                    "geometry.flat_length=8 mm"]))
+    assert plain > 1.15 and rounded < plain - 0.05, (plain, rounded)
+
+
+def test_a_tabulated_profile_is_read_with_its_units_and_carried_in_the_filled_case(tmp_path):
+    (tmp_path / "profile.csv").write_text("y [mm], drop [um]\n0, 0\n4.5, 0\n5, 2\n")
+    text = (CASES / "roller_edge_rounded.yaml").read_text().replace(
+        "edge_radius: 20 mm, flat_length: 9 mm", "profile: profile.csv")
+    (tmp_path / "r.yaml").write_text(text)
+    case = load_case(tmp_path / "r.yaml")
+    assert case.geometry.drop(np.array([5.0]))[0] == pytest.approx(0.002)
+    from fretsim.case import parse_case
+    again = parse_case(case.to_yaml())  # no file needed any more
+    assert again.geometry.profile_drop == case.geometry.profile_drop
+
+
+def test_a_profile_without_units_in_its_header_is_refused(tmp_path):
+    (tmp_path / "profile.csv").write_text("y, drop\n0, 0\n5, 2\n")
+    text = (CASES / "roller_edge_rounded.yaml").read_text().replace(
+        "edge_radius: 20 mm, flat_length: 9 mm", "profile: profile.csv")
+    (tmp_path / "r.yaml").write_text(text)
+    r = CliRunner().invoke(main, ["check", str(tmp_path / "r.yaml")])
+    assert r.exit_code == 2 and "geometry.profile" in r.output and "units" in r.output
+
+
+# --- what auto chooses, and check on every shipped case --------------------------------------------------------------
+
+@pytest.mark.parametrize("name, dimension", [("mccoll_185N", "3d"), ("roller_edge_rounded", "3d"),
+                                             ("tube_RT", "2d"), ("seat_rail", "3d")])
+def test_auto_picks_2d_where_the_ends_do_not_change_what_is_reported_and_3d_where_they_do(name, dimension):
+    # the picks scripts/study_model_hierarchy.py confirms against the full models (2D off by 2.0 % and 4.3 % for
+    # the cylinder and the roller, 0.14-0.24 % for the tube)
+    _, filled, plan = prepare(load_case(CASES / f"{name}.yaml", ["model.dimension=auto"]))
+    assert filled.dimension == dimension
+    assert next(c for c in plan.choices if c.key == "model.dimension").reason
+
+
+def test_auto_leaves_out_ring_bending_that_changes_nothing_reported_and_says_so():
+    _, filled, plan = prepare(load_case(CASES / "tube_RT.yaml"))
+    choice = next(c for c in plan.choices if c.key == "model.corrections")
+    assert choice.value == () and "0.1" in choice.reason and "within model.accuracy" in choice.reason
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_check_runs_on_every_shipped_case(name):
+    r = CliRunner().invoke(main, ["check", str(CASES / f"{name}.yaml")])
+    assert r.exit_code == 0 and "choices:" in r.output, r.output
+
+
+@pytest.mark.parametrize("name", SHIPPED)
+def test_every_shipped_case_runs_and_keeps_archards_volume(name):
+    out = run(load_case(CASES / f"{name}.yaml", ["loading.cycles=500", "output.snapshots=auto"]))
+    assert out.status == "complete", out.message
+    assert out.summary["archard_volume_error"] < 1e-9
