@@ -360,6 +360,33 @@ def init(kind: str, output: Path | None) -> None:
     click.echo(str(output))
 
 
+@main.command()
+@click.argument("cases", nargs=-1)
+@click.option("-o", "--outdir", type=click.Path(file_okay=False, path_type=Path), default=Path("validation"),
+              show_default=True, help="Directory for report.md and its figures.")
+@click.option("--jobs", type=click.IntRange(0, 256), default=0, help="Parallel runs (default: the number of cores).")
+@click.option("--quick", is_flag=True, help="Line contacts in 2D and point contacts short: the check in a minute.")
+@click.option("--debug", is_flag=True, help="Show tracebacks.")
+def validate(cases: tuple, outdir: Path, jobs: int, quick: bool, debug: bool) -> None:
+    """Run the published cases of the paper (default: every shipped case with expected values) and write a
+    report against experiment, FEA and the paper.  Exit 0 when every case runs."""
+    from fretsim.case import CaseError
+    from fretsim.validate import shipped_with_expected, validate as run_validation
+
+    names = list(cases) or shipped_with_expected()
+    unknown = [n for n in names if n not in shipped_with_expected()]
+    if unknown:
+        _fail(f"no shipped case with expected values named {', '.join(unknown)}; choose from "
+              f"{', '.join(shipped_with_expected())}", EXIT_BAD_INPUT, debug)
+    try:
+        out = run_validation(names, outdir, jobs, quick)
+    except CaseError as exc:
+        _fail(str(exc), EXIT_BAD_INPUT, debug)
+    click.echo(f"{len(out['results'])} runs; report: {out['report']}")
+    if not out["ok"]:
+        _fail("some cases did not complete: see the report", EXIT_FAILED, debug)
+
+
 @main.command("case-reference")
 def case_reference() -> None:
     """Print every case key with its unit, default and meaning (Markdown), from the parser's own schema."""
