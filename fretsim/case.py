@@ -8,7 +8,9 @@ cannot drift from the parser.  Values are stored in the internal mm–N–MPa sy
 """
 from __future__ import annotations
 
+import copy
 import difflib
+import functools
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -45,6 +47,7 @@ class Key:
     choices: tuple = ()
     positive: bool = True  # quantities: must be > 0 (else ≥ 0)
     example: str = ""  # a value for templates (`fretsim init`) where there is no default
+    any_case: bool = False  # choices: also accepted in capitals (2D/3D, as the paper and the summaries print them)
 
     def unit(self) -> str:
         from fretsim.units import INTERNAL
@@ -107,7 +110,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
                                     hi=10.0)},
     "model": {
         "dimension": Key("choice", "2d (line contact per unit length), 3d, or auto: the cheapest within "
-                                   "model.accuracy", "auto", choices=DIMENSIONS),
+                                   "model.accuracy", "auto", choices=DIMENSIONS, any_case=True),
         "gap": Key("choice", "how the flat's wear enters the gap: mid_stroke (the paper, Eq. 18), stroke_average "
                              "(stable for any wear coefficients) or auto", "auto", choices=GAP_MODELS),
         "corrections": Key("corrections", "compliance added to the half-spaces: `auto` (each where its effect "
@@ -278,10 +281,16 @@ def load_case(path: str | Path, overrides: Optional[list[str]] = None) -> Case:
     return parse_case(text, source=source, overrides=overrides, default_name=path.stem)
 
 
+@functools.lru_cache(maxsize=4)
+def _loads_cached(text: str):
+    # a sweep validates one base text once per point: parse it once per process
+    return loads(text)
+
+
 def parse_case(text: str, source: str = "<case>", overrides: Optional[list[str]] = None,
                default_name: str = "case") -> Case:
     try:
-        raw = loads(text)
+        raw = copy.deepcopy(_loads_cached(text))  # overrides edit the tree in place
     except YamlProblem as exc:
         raise CaseError(source, [(exc.path, exc.message)]) from None
     if raw is None:
@@ -376,8 +385,11 @@ class _Reader:
         if kind == "integer":
             return self.integer(value, spec, path)
         if kind == "choice":
-            if isinstance(value, str) and value.lower() in spec.choices:
-                return value.lower()
+            # exact, like the keys ("Stroke" is not "stroke"); a near miss gets a hint
+            if isinstance(value, str) and spec.any_case:
+                value = value.lower()
+            if isinstance(value, str) and value in spec.choices:
+                return value
             hint = difflib.get_close_matches(str(value).lower(), spec.choices, n=1) if isinstance(value, str) else []
             self.fail(path, f"unknown value {excerpt(value)}" + (f" (did you mean '{hint[0]}'?)" if hint else "")
                       + f"; expected one of {', '.join(spec.choices)}")
@@ -412,8 +424,8 @@ class _Reader:
                 return None
             return tuple(ys), tuple(ds)
         if kind == "corrections":
-            if isinstance(value, str) and value.lower() in ("auto", "none"):
-                return value.lower()
+            if isinstance(value, str) and value in ("auto", "none"):
+                return value
             items = value if isinstance(value, list) else None
             if items is None or not all(isinstance(v, str) and v in CORRECTIONS for v in items):
                 self.fail(path, f"expected auto, none, or a list of {', '.join(CORRECTIONS)}; got {excerpt(value)}")

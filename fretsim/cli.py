@@ -293,15 +293,27 @@ def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> N
 @main.command()
 @click.argument("results_file", type=click.Path(path_type=Path))
 @click.option("-o", "--outdir", type=click.Path(file_okay=False, path_type=Path),
-              help="Directory for the figures (default: next to RESULTS_FILE).")
+              help="Directory for the figures (default: next to RESULTS_FILE, or in a sweep's directory).")
 @click.option("--format", "fmt", type=click.Choice(["png", "pdf", "svg"]), default="png", show_default=True)
 @click.option("--dpi", type=click.IntRange(50, 1200), default=150, show_default=True)
 @click.option("--log", "log_cycles", is_flag=True, help="Logarithmic cycle axis for the histories.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
 def plot(results_file: Path, outdir: Path | None, fmt: str, dpi: int, log_cycles: bool, debug: bool) -> None:
     """Write figures of RESULTS_FILE: wear profiles across and along the contact, wear and pressure maps,
-    pressure profiles with the initial Hertz solution, depth and volume against cycles."""
+    pressure profiles with the initial Hertz solution, depth and volume against cycles.  Given a sweep's
+    directory: response curves, each output against each swept axis, one line per value of the others."""
     from fretsim.results import read_results
+
+    if results_file.is_dir():
+        from fretsim.results import read_sweep_table
+        try:
+            table = read_sweep_table(results_file)
+        except ValueError as exc:
+            _fail(str(exc), EXIT_BAD_INPUT, debug)
+        from fretsim.plotting import plot_sweep
+        for p in plot_sweep(table, outdir or results_file, fmt=fmt, dpi=dpi):
+            click.echo(str(p))
+        return
 
     try:
         res = read_results(results_file)
@@ -385,6 +397,57 @@ def validate(cases: tuple, outdir: Path, jobs: int, quick: bool, debug: bool) ->
     click.echo(f"{len(out['results'])} runs; report: {out['report']}")
     if not out["ok"]:
         _fail("some cases did not complete: see the report", EXIT_FAILED, debug)
+
+
+@main.command()
+@click.argument("sweep_file", type=click.Path(path_type=Path))
+@click.option("-o", "--outdir", type=click.Path(file_okay=False, path_type=Path), required=True,
+              help="Directory for the points' results files and the table.")
+@click.option("--jobs", type=click.IntRange(0, 1024), default=0, help="Local worker processes (default: the cores).")
+@click.option("--dask", "dask_address", metavar="tcp://HOST:PORT", help="Run the points on this Dask scheduler.")
+@click.option("--overwrite", is_flag=True, help="Run every point again, complete ones too.")
+@click.option("--debug", is_flag=True, help="Show tracebacks.")
+def sweep(sweep_file: Path, outdir: Path, jobs: int, dask_address: str | None, overwrite: bool, debug: bool) -> None:
+    """Run every point of SWEEP_FILE (long-lived workers, or a Dask cluster) and write one table.
+
+    Re-running skips complete points and resumes interrupted ones.  Exit 0 when every point completed, 3 when
+    some failed or were refused (see DIR/table.csv), 2 for a bad sweep file, 130 interrupted."""
+    import os
+    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # before numpy loads: one BLAS
+        os.environ.setdefault(var, "1")                                        # thread per worker
+    from fretsim.case import CaseError
+    from fretsim.sweep import load_sweep, run_sweep
+
+    try:
+        spec = load_sweep(sweep_file)
+    except CaseError as exc:
+        _fail(str(exc), EXIT_BAD_INPUT, debug)
+    failures = {"n": 0}
+    bar = None
+    if sys.stderr.isatty():
+        bar = click.progressbar(length=len(spec.points), label="points", file=sys.stderr,
+                                item_show_func=lambda _: f"{failures['n']} failed" if failures["n"] else "")
+        bar.__enter__()
+
+    def _progress(row):
+        if row["status"] != "complete":
+            failures["n"] += 1
+        if bar is not None:
+            bar.update(1)
+    try:
+        out = run_sweep(spec, outdir, jobs, dask_address, overwrite, _progress)
+    except CaseError as exc:
+        _fail(str(exc), EXIT_BAD_INPUT, debug)
+    except KeyboardInterrupt:
+        _fail(f"interrupted; the points done so far are in {outdir} and its table; run the same command again to "
+              f"continue", EXIT_INTERRUPTED, debug)
+    finally:
+        if bar is not None:
+            bar.__exit__(None, None, None)
+    counts = ", ".join(f"{n} {s}" for s, n in sorted(out.counts.items()))
+    click.echo(f"{len(out.rows)} points: {counts}. Table: {out.table_csv}, {out.table_h5}")
+    if not out.all_complete:
+        sys.exit(EXIT_FAILED)
 
 
 @main.command("case-reference")

@@ -17,7 +17,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import MaxNLocator, ScalarFormatter  # noqa: E402
 
-from fretsim.results import Results  # noqa: E402
+from fretsim.results import Results, SweepTable  # noqa: E402
 
 STYLES = ["-", "--", "-.", ":", (0, (5, 1)), (0, (3, 1, 1, 1))]
 
@@ -241,3 +241,74 @@ def _history(res: Results, log_cycles: bool):
     axes[0].set_title("maximum wear depth (a marker per contact solve)")
     axes[1].set_title("wear volume against Archard's law")
     return fig
+
+
+SWEEP_OUTPUTS = ("centre_wear_depth_stationary_um", "max_wear_depth_moving_um", "scar_width_stationary_mm",
+                 "wall_time_s")
+
+
+def plot_sweep(table: SweepTable, outdir: str | Path, fmt: str = "png", dpi: int = 150) -> list[Path]:
+    """Response curves: each output against each swept axis, one line per combination of the other axes."""
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    axes = list(table.axes)
+    if not axes:
+        raise ValueError(f"{table.path}: the sweep has no axes (a list of points): nothing to draw curves over")
+    paths = []
+    for axis in axes:
+        fig, ax_list = plt.subplots(1, len(SWEEP_OUTPUTS), figsize=(4.2 * len(SWEEP_OUTPUTS), 3.8), squeeze=False)
+        others = [a for a in axes if a != axis]
+        groups: dict = {}
+        for row in table.rows:
+            groups.setdefault(tuple(row.get(o, "") for o in others), []).append(row)
+        values = table.axes[axis]
+        for k, (key, rows) in enumerate(groups.items()):
+            order = {str(v): i for i, v in enumerate(_as_written(table, axis))}
+            rows = sorted(rows, key=lambda r: order.get(r.get(axis, ""), 0))
+            xs = [values[order[r[axis]]] if r.get(axis) in order else np.nan for r in rows]
+            label = ", ".join(f"{o.split('.')[-1]} = {v}" for o, v in zip(others, key)) or None
+            for ax, out in zip(ax_list[0], SWEEP_OUTPUTS):
+                ys = [float(r[out]) if r.get(out) not in (None, "") and r.get("status") == "complete" else np.nan
+                      for r in rows]
+                ax.plot(xs, ys, ls=STYLES[k % len(STYLES)], marker="o", ms=3, label=label)
+        for ax, out in zip(ax_list[0], SWEEP_OUTPUTS):
+            unit = table.units.get(axis, "")
+            ax.set_xlabel(f"{axis} ({unit})" if unit and unit != "1" else axis)
+            ax.set_ylabel(out.rsplit("_", 1)[0].replace("_", " ") + f" ({out.rsplit('_', 1)[1].replace('um', 'µm')})")
+            ax.grid(alpha=0.3)
+        if groups and next(iter(groups)):
+            ax_list[0][0].legend(fontsize=7)
+        fig.suptitle(f"{Path(table.path).name}: response to {axis}", fontsize=10)
+        fig.tight_layout()
+        path = outdir / f"sweep_{axis.replace('.', '_')}.{fmt}"
+        fig.savefig(path, dpi=dpi)
+        plt.close(fig)
+        paths.append(path)
+    return paths
+
+
+def _as_written(table: SweepTable, axis: str) -> list:
+    import json
+    import h5py
+    with h5py.File(Path(table.path) / "table.h5", "r") as f:
+        return json.loads(f[axis].attrs["as_written"])
+
+
+def grouped_bars(labels: list[str], panels: dict, path: str | Path, title: str, dpi: int = 130) -> Path:
+    """Side-by-side panels of grouped bars: ``panels`` maps a y label to {series label: values (None = gap)}."""
+    fig, axes = plt.subplots(1, len(panels), figsize=(6.5 * len(panels), 4.6), squeeze=False)
+    x = np.arange(len(labels))
+    for ax, (ylabel, series) in zip(axes[0], panels.items()):
+        width = 0.8 / max(len(series), 1)
+        for k, (name, values) in enumerate(series.items()):
+            ax.bar(x + (k - (len(series) - 1) / 2) * width, [np.nan if v is None else v for v in values], width,
+                   label=name)
+        ax.set_xticks(x, labels, fontsize=7)
+        ax.set_ylabel(ylabel)
+        ax.grid(alpha=0.3, axis="y")
+    axes[0][0].legend(fontsize=8)
+    fig.suptitle(title)
+    fig.tight_layout()
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    return Path(path)

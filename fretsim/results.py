@@ -21,8 +21,9 @@ image, writes it with plain file I/O to a temporary file beside the target, fsyn
 target (atomic on POSIX).  HDF5 therefore never writes to a disk that can fail: a full disk or an I/O error is
 an ordinary OSError at a known point, after which the temporary is removed and the last good file is intact
 (:class:`ResultsIOError`).  The first placement uses a hard link, which fails if the name appeared meanwhile,
-so a results file is never replaced without overwrite.  Flushes happen at the first step, then at most every
-FLUSH_SECONDS, and at the end.
+so a results file is never replaced without overwrite.  Flushes happen at most every FLUSH_SECONDS (the first
+FLUSH_SECONDS into the run), or 20 times the last flush's cost if longer, and at the end: a run shorter than
+that writes its file once.
 
 Claiming.  A run holds an exclusive ``flock`` on a lock file beside its output for as long as it may write it
 (:class:`OutputClaim`), so two runs never share one output, with or without overwrite; the kernel releases the
@@ -54,6 +55,7 @@ from fretsim import __version__
 FORMAT_VERSION = "1.2"
 READABLE_FORMATS = ("1.1", "1.2")
 FLUSH_SECONDS = 0.5
+FLUSH_COST_FACTOR = 20.0  # flushes no more often than this many times their own cost (≤ ~5 % of the run)
 STATUSES = ("running", "complete", "interrupted", "failed", "stopped")
 MAX_DATASET_BYTES = 2**32  # 4 GiB: no results file of this tool holds a larger array
 MAX_NAME = 200  # bytes of the output's base name we accept (temporaries use fixed-length names)
@@ -234,6 +236,8 @@ class ResultsWriter:
         self.status, self.message, self.summary = "running", "", {}
         self.state: Optional[dict] = None
         self._flushed = -math.inf
+        self._started: Optional[float] = None
+        self._flush_cost = 0.0  # seconds the last flush took
         self._placed = self.path.exists() and self.replace
 
     def on_step(self, setup, step) -> None:
@@ -243,9 +247,14 @@ class ResultsWriter:
             for name, (_, _, get) in FIELDS.items():
                 self.fields[name].append(np.array(get(step)))
         self.state = step.state
-        # the first step (so the file exists at once), then at most every FLUSH_SECONDS: each flush rewrites the
-        # whole file, and a kill costs at most the steps since the last one, which --resume recomputes
-        if len(self.rows) == 1 or time.monotonic() - self._flushed > FLUSH_SECONDS:
+        # at most every FLUSH_SECONDS, the first FLUSH_SECONDS into the run: each flush rewrites the whole file,
+        # a kill costs at most the steps since the last one (which --resume recomputes), and a run shorter than
+        # that writes its file once, at the end
+        now = time.monotonic()
+        if self._started is None:
+            self._started = self._flushed = now
+        # a flush rebuilds the whole file (tens of ms): never let flushing take more than ~5 % of a long run
+        if now - self._flushed > max(FLUSH_SECONDS, FLUSH_COST_FACTOR * self._flush_cost):
             self.flush()
 
     def finish(self, status: str, message: str = "", summary: Optional[dict] = None) -> None:
@@ -263,6 +272,7 @@ class ResultsWriter:
     def flush(self) -> None:
         """Write the whole file beside the target and move it over the target (atomic); ResultsIOError if the
         disk refuses, with the last good file left as it was and no temporary left behind."""
+        started = time.monotonic()
         data = self.image()
         tmp = self.path.with_name(f".fretsim-{os.getpid()}-{os.urandom(4).hex()}.tmp")
         try:
@@ -300,6 +310,7 @@ class ResultsWriter:
             except OSError:
                 pass
         self._flushed = time.monotonic()
+        self._flush_cost = self._flushed - started
 
     def _write(self, f: h5py.File) -> None:
         grid = self.grid
@@ -646,3 +657,35 @@ def summary_json(res: Results) -> dict:
     data["input_units"] = {k: v[1] for k, v in res.inputs.items()}
     data["overrides"] = list(res.overrides)
     return data
+
+
+@dataclass
+class SweepTable:
+    """A sweep's table read back: its axes (key → values as numbers in their units, or text), units, rows."""
+
+    path: str
+    axes: dict
+    units: dict
+    rows: list
+
+
+def read_sweep_table(directory: str | Path) -> SweepTable:
+    """The table of a sweep directory (table.h5 for the axes, table.csv for the rows)."""
+    import csv
+    directory = Path(directory)
+    try:
+        with h5py.File(directory / "table.h5", "r") as f:
+            spec = json.loads(_text(f.attrs["sweep"]))
+            axes, units = {}, {}
+            for k in spec.get("axes", {}):
+                ds = f[k]
+                axes[k] = [v.decode() if isinstance(v, bytes) else v for v in ds[()].tolist()]
+                units[k] = _text(ds.attrs.get("units", ""))
+            for k, ds in f.items():
+                if isinstance(ds, h5py.Dataset) and k in SUMMARY_UNITS:
+                    units[k] = _text(ds.attrs.get("units", ""))
+        with open(directory / "table.csv", newline="") as fh:
+            rows = list(csv.DictReader(fh))
+    except (OSError, KeyError, ValueError, TypeError) as exc:
+        raise ValueError(f"{directory}: not a sweep's directory with a readable table ({exc})") from None
+    return SweepTable(str(directory), axes, units, rows)

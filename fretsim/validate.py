@@ -277,23 +277,12 @@ def build_report(cases: dict, results: dict, outdir: Path, quick: bool) -> str:
 
 
 def _table4_figure(names: list[str], cases: dict, results: dict, path: Path) -> None:
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    fig, axes = plt.subplots(1, 2, figsize=(13, 4.6))
-    x = np.arange(len(names))
-    for ax, q, unit in ((axes[0], "centre_wear_depth_stationary", "µm"), (axes[1], "scar_width_stationary", "mm")):
-        for k, (label, get) in enumerate((("experiment", lambda n: cases[n][1].values.get("experiment", {}).get(q)),
-                                          ("FEA", lambda n: cases[n][1].values.get("fea", {}).get(q)),
-                                          ("paper", lambda n: cases[n][1].values.get("paper", {}).get(q)),
-                                          ("fretsim", lambda n: _value(results[n], q)))):
-            vals = [get(n) for n in names]
-            ax.bar(x + (k - 1.5) * 0.2, [np.nan if v is None else v for v in vals], 0.2, label=label)
-        ax.set_xticks(x, [n.replace("_", "\n", 1) for n in names], fontsize=7)
-        ax.set_ylabel(f"{q.replace('_', ' ')} ({unit})")
-        ax.grid(alpha=0.3, axis="y")
-    axes[0].legend(fontsize=8)
-    fig.suptitle("Kong, Bennett & Hyde Table 4: experiment, FEA, the paper's model and fretsim")
-    fig.tight_layout()
-    fig.savefig(path, dpi=130)
-    plt.close(fig)
+    from fretsim.plotting import grouped_bars
+    panels = {}
+    for q, unit in (("centre_wear_depth_stationary", "µm"), ("scar_width_stationary", "mm")):
+        series = {label: [cases[n][1].values.get(source, {}).get(q) for n in names]
+                  for label, source in (("experiment", "experiment"), ("FEA", "fea"), ("paper", "paper"))}
+        series["fretsim"] = [_value(results[n], q) for n in names]
+        panels[f"{q.replace('_', ' ')} ({unit})"] = series
+    grouped_bars([n.replace("_", "\n", 1) for n in names], panels, path,
+                 "Kong, Bennett & Hyde Table 4: experiment, FEA, the paper's model and fretsim")

@@ -1,0 +1,418 @@
+"""Sweeps: one case over many values, in long-lived workers (local or an existing Dask cluster), one table.
+
+A sweep file (YAML, read as strictly as a case):
+
+    base: mccoll_185N.yaml          # a case file (relative to the sweep file), or a case mapping inline
+    set: [model.dimension=2d]       # overrides every point shares (optional)
+    mode: product                   # product (every combination) | zip (the i-th values together) | points
+    axes:                           # dotted case keys, each with a list of values (units as in a case)
+      loading.normal_load: [150 N, 185 N, 250 N]
+      loading.stroke: [10 um, 25 um]
+    points:                         # mode: points — an explicit list, e.g. a design of experiments
+      - {jumping.eta: 0.1, jumping.max: 100}
+
+Every point is named from its values (the same values, the same name) and writes the ordinary results file
+DIR/points/NAME.h5, whose /inputs record the point's overrides.  DIR/table.csv and DIR/table.h5 hold one row
+per point: its swept values, status, message and summary.  table.h5 is readable by xarray (engine
+"h5netcdf"): a product sweep's outputs are arrays over its axes, with the axis values as coordinates (numbers
+in mm, N, MPa, 1/MPa, with units); other sweeps run over a ``point`` dimension.
+
+Re-running a sweep skips complete points and resumes interrupted ones (their results files say which); a point
+that fails or is refused is recorded with its status and message and does not stop the others.
+"""
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+import re
+import signal
+from dataclasses import dataclass, field
+from itertools import product
+from pathlib import Path
+from typing import Callable, Optional
+
+from fretsim.case import CaseError, parse_case
+from fretsim.units import UNITS, UnitError, parse_quantity
+from fretsim.yamlread import YamlProblem, excerpt, loads, read_text
+
+MODES = ("product", "zip", "points")
+MAX_POINTS = 100_000
+DASK_CONNECT_TIMEOUT = "10s"  # a scheduler that does not answer within this is reported, not waited on
+KEYS = {"base", "set", "mode", "axes", "points"}
+
+
+@dataclass(frozen=True)
+class Point:
+    name: str
+    overrides: tuple  # ("key=value", ...) the point's own, after the shared ones
+    values: dict  # key → value as written
+
+
+@dataclass
+class Sweep:
+    source: str
+    base_text: str
+    base_source: str
+    shared: tuple
+    mode: str
+    axes: dict  # key → list of values (product, zip)
+    points: list = field(default_factory=list)
+
+    def spec(self) -> dict:
+        """What defines the sweep (stored beside its results: a changed sweep gets its own new points)."""
+        return {"base": self.base_source, "set": list(self.shared), "mode": self.mode,
+                "axes": {k: [str(v) for v in vs] for k, vs in self.axes.items()},
+                "points": [p.name for p in self.points]}
+
+
+def _text(v) -> str:
+    return v if isinstance(v, str) else json.dumps(v)
+
+
+def point_name(values: dict) -> str:
+    """A file-system-safe name from a point's values, unique by a hash of all of them."""
+    canonical = json.dumps([[k, _text(v)] for k, v in sorted(values.items())])
+    digest = hashlib.sha1(canonical.encode()).hexdigest()[:8]
+    parts = [f"{k.split('.')[-1]}={_text(v)}" for k, v in values.items()]
+    slug = re.sub(r"[^A-Za-z0-9.=_-]+", "", "_".join(parts))[:80]
+    return f"{slug}-{digest}" if slug else digest
+
+
+def load_sweep(path: str | Path) -> Sweep:
+    """Read and check a sweep file: every problem with its YAML path, and every point's case validated."""
+    path = Path(path)
+    source = str(path)
+    try:
+        raw = loads(read_text(path, "sweep file"))
+    except (OSError, ValueError) as exc:
+        where = exc.path if isinstance(exc, YamlProblem) else ""
+        raise CaseError(source, [(where, getattr(exc, "message", str(exc)))], "sweep file") from None
+    if not isinstance(raw, dict):
+        raise CaseError(source, [("", "expected a mapping with base, axes (or points), and optionally set and mode")],
+                        "sweep file")
+    problems = []
+    for k in raw:
+        if k not in KEYS:
+            problems.append((str(k)[:40], f"unknown key; allowed: {', '.join(sorted(KEYS))}"))
+    base = raw.get("base")
+    base_text = base_source = ""
+    if isinstance(base, str):
+        base_path = path.parent / base
+        try:
+            base_text, base_source = read_text(base_path, "base case file"), str(base_path)
+        except (OSError, ValueError) as exc:
+            problems.append(("base", f"{base_path}: {exc}"))
+    elif isinstance(base, dict):
+        import yaml
+        base_text, base_source = yaml.safe_dump(base, sort_keys=False, allow_unicode=True), f"{source}:base"
+    else:
+        problems.append(("base", "missing; expected a case file name or an inline case mapping"))
+    shared = raw.get("set", [])
+    if not isinstance(shared, list) or not all(isinstance(s, str) and "=" in s for s in shared):
+        problems.append(("set", "expected a list of key.path=value overrides, e.g. [model.dimension=2d]"))
+        shared = []
+    mode = raw.get("mode", "points" if "points" in raw and "axes" not in raw else "product")
+    if mode not in MODES:
+        problems.append(("mode", f"unknown value {excerpt(mode)}; expected one of {', '.join(MODES)}"))
+    axes = raw.get("axes", {}) if mode != "points" else {}
+    points: list[dict] = []
+    if mode in ("product", "zip"):
+        if not isinstance(axes, dict) or not axes:
+            problems.append(("axes", "expected a mapping of case keys to lists of values"))
+            axes = {}
+        for k, vs in axes.items():
+            if not isinstance(k, str) or "." not in k:
+                problems.append((f"axes.{str(k)[:40]}", "expected a dotted case key, e.g. loading.normal_load"))
+            if not isinstance(vs, list) or not vs:
+                problems.append((f"axes.{k}", "expected a non-empty list of values"))
+        good = {k: vs for k, vs in axes.items() if isinstance(vs, list) and vs}
+        if mode == "zip" and len({len(vs) for vs in good.values()}) > 1:
+            problems.append(("axes", f"zip needs lists of one length; got {', '.join(f'{k}: {len(v)}' for k, v in good.items())}"))
+        count = 1
+        for vs in good.values():
+            count *= len(vs)
+        if mode == "product" and count > MAX_POINTS:
+            problems.append(("axes", f"{count} points; at most {MAX_POINTS}"))
+        elif not problems:
+            keys = list(good)
+            combos = product(*good.values()) if mode == "product" else zip(*good.values())
+            points = [dict(zip(keys, c)) for c in combos]
+    elif mode == "points":
+        listed = raw.get("points")
+        if not isinstance(listed, list) or not listed or not all(isinstance(p, dict) and p for p in listed):
+            problems.append(("points", "expected a list of mappings of case keys to values"))
+        elif len(listed) > MAX_POINTS:
+            problems.append(("points", f"{len(listed)} points; at most {MAX_POINTS}"))
+        else:
+            points = listed
+    sweep = Sweep(source, base_text, base_source, tuple(shared), mode, axes if isinstance(axes, dict) else {})
+    names = set()
+    for i, values in enumerate(points):
+        overrides = tuple(f"{k}={_text(v)}" for k, v in values.items())
+        try:
+            parse_case(base_text, source=base_source, overrides=[*shared, *overrides])
+        except CaseError as exc:
+            label = f"points[{i}]" if mode == "points" else f"point {', '.join(f'{k}={_text(v)}' for k, v in values.items())}"
+            problems += [(f"{label}: {p}" if p else label, m) for p, m in exc.problems]
+            continue
+        name = point_name(values)
+        if name in names:
+            problems.append((f"points[{i}]", f"the same values as an earlier point ({name})"))
+        names.add(name)
+        sweep.points.append(Point(name, overrides, dict(values)))
+    if problems:
+        raise CaseError(source, problems[:50] + ([("", f"… and {len(problems) - 50} more")] if len(problems) > 50
+                                                 else []), "sweep file")
+    return sweep
+
+
+# --- running the points ------------------------------------------------------------------------------------------
+
+def _init_worker() -> None:
+    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ[var] = "1"
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent stops the sweep; workers finish or are ended
+
+
+def run_point(task: tuple) -> dict:
+    """Run (or resume) one point, writing its results file; returns the point's status.  In a worker process."""
+    name, base_text, base_source, overrides, output, mode = task
+    from fretsim.api import resume, run
+    try:
+        if mode == "resume":
+            outcome = resume(output)
+        else:
+            case = parse_case(base_text, source=base_source, overrides=list(overrides))
+            outcome = run(case, output, overwrite=True)
+        return {"name": name, "status": outcome.status, "message": outcome.message, "summary": outcome.summary}
+    except CaseError as exc:
+        return {"name": name, "status": "refused", "message": str(exc)}
+    except Exception as exc:  # noqa: BLE001 - a point's failure is recorded, the sweep goes on
+        return {"name": name, "status": "failed", "message": f"{type(exc).__name__}: {exc}"}
+
+
+def run_point_remote(task: tuple) -> dict:
+    """As :func:`run_point` on a Dask worker that may not share DIR: writes to a temporary file, returns bytes."""
+    import tempfile
+    name, base_text, base_source, overrides, _, mode = task
+    with tempfile.TemporaryDirectory() as tmp:
+        out = Path(tmp) / f"{name}.h5"
+        row = run_point((name, base_text, base_source, overrides, out, "run"))
+        row["data"] = out.read_bytes() if out.exists() else None
+    return row
+
+
+def _state(path: Path) -> str:
+    """What a point's results file says: missing, complete, resumable, or done (failed/stopped), unreadable."""
+    if not path.exists():
+        return "missing"
+    from fretsim.results import read_results
+    try:
+        status = read_results(path).status
+    except ValueError:
+        return "unreadable"
+    return {"complete": "complete", "running": "resumable", "interrupted": "resumable"}.get(status, "done")
+
+
+@dataclass
+class SweepOutcome:
+    rows: list
+    table_csv: Path
+    table_h5: Path
+    counts: dict
+
+    @property
+    def all_complete(self) -> bool:
+        return all(r["status"] == "complete" for r in self.rows)
+
+    def to_pandas(self):
+        """The table as a pandas DataFrame (needs pandas)."""
+        import pandas as pd
+        return pd.DataFrame(self.rows)
+
+    def to_xarray(self):
+        """The table as an xarray Dataset (needs xarray and h5netcdf)."""
+        import xarray as xr
+        return xr.open_dataset(self.table_h5, engine="h5netcdf")
+
+
+def run_sweep(sweep: Sweep, outdir: str | Path, jobs: int = 0, dask: Optional[str] = None,
+              overwrite: bool = False, progress: Optional[Callable[[dict], None]] = None) -> SweepOutcome:
+    """Run every point not yet complete; write the table.  KeyboardInterrupt stops cleanly (the table of what is
+    done is written first); a re-run continues."""
+    outdir = Path(outdir)
+    (outdir / "points").mkdir(parents=True, exist_ok=True)
+    spec_path = outdir / "sweep.json"
+    spec_path.write_text(json.dumps(sweep.spec(), indent=1))
+    statuses = {}
+    tasks = []
+    for p in sweep.points:
+        out = outdir / "points" / f"{p.name}.h5"
+        state = "missing" if overwrite else _state(out)
+        if state == "complete" or state == "done":
+            statuses[p.name] = None  # read from its file for the table
+            continue
+        if state == "unreadable":
+            out.unlink()
+        mode = "resume" if state == "resumable" else "run"
+        tasks.append((p.name, sweep.base_text, sweep.base_source, (*sweep.shared, *p.overrides), out, mode))
+    try:
+        if dask:
+            results = _run_dask(tasks, dask, progress)
+        else:
+            results = _run_local(tasks, jobs or os.cpu_count() or 1, progress)
+        statuses.update({r["name"]: r for r in results})
+    finally:
+        rows = _table_rows(sweep, outdir, statuses)
+        csv_path, h5_path = write_table(sweep, rows, outdir)
+    counts = {s: sum(1 for r in rows if r["status"] == s) for s in {r["status"] for r in rows}}
+    return SweepOutcome(rows, csv_path, h5_path, counts)
+
+
+def _run_local(tasks: list, jobs: int, progress) -> list:
+    import multiprocessing as mp
+    from concurrent.futures import ProcessPoolExecutor, as_completed
+    if not tasks:
+        return []
+    results = []
+    # fork where there is fork: the workers start with fretsim already imported (a spawned one re-imports
+    # numpy, scipy and h5py, a second or two each); the CLI pins BLAS to one thread before numpy loads
+    ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
+    if ctx.get_start_method() == "fork":
+        import fretsim.api  # noqa: F401 - imported once here (scipy's FFT and interpolation, ~1.5 s), not per worker
+    pool = ProcessPoolExecutor(max_workers=max(1, min(jobs, len(tasks))), mp_context=ctx, initializer=_init_worker)
+    try:
+        futures = [pool.submit(run_point, t) for t in tasks]
+        for f in as_completed(futures):
+            r = f.result()
+            results.append(r)
+            if progress is not None:
+                progress(r)
+    except BaseException:
+        pool.shutdown(wait=False, cancel_futures=True)
+        for proc in list(getattr(pool, "_processes", {}).values()):
+            proc.terminate()  # SIGTERM: a running point records itself as interrupted, and resumes next time
+        raise
+    pool.shutdown(wait=True)
+    return results
+
+
+def _run_dask(tasks: list, address: str, progress) -> list:
+    try:
+        from distributed import Client, as_completed
+    except ImportError:
+        raise CaseError("--dask", [("", "needs Dask's distributed: pip install 'fretsim[dask]'")]) from None
+    results = []
+    try:
+        client = Client(address, timeout=DASK_CONNECT_TIMEOUT)
+    except (OSError, TimeoutError) as exc:
+        raise CaseError("--dask", [("", f"cannot reach the scheduler at {address}: {exc}")]) from None
+    try:
+        futures = client.map(run_point_remote, tasks, pure=False)
+        for f in as_completed(futures):
+            r = f.result()
+            data = r.pop("data", None)
+            out = next(t[4] for t in tasks if t[0] == r["name"])
+            if data is not None:
+                tmp = out.with_name(f".{out.name}.part")
+                tmp.write_bytes(data)
+                os.replace(tmp, out)
+            results.append(r)
+            if progress is not None:
+                progress(r)
+    finally:
+        client.close()
+    return results
+
+
+def _table_rows(sweep: Sweep, outdir: Path, statuses: dict) -> list:
+    from fretsim.results import read_results
+    rows = []
+    for p in sweep.points:
+        out = outdir / "points" / f"{p.name}.h5"
+        row = {"point": p.name, **{k: _text(v) for k, v in p.values.items()}}
+        known = statuses.get(p.name)
+        if known and (known.get("summary") or known.get("status") == "refused"):  # this run's: no need to read
+            row.update(status=known["status"], message=known.get("message", ""))
+            row.update(known.get("summary") or {})
+        else:
+            try:
+                res = read_results(out)
+                row.update(status=res.status, message=res.attrs.get("status_message", ""))
+                row.update(res.summary)
+            except ValueError:
+                row.update(status=(known or {}).get("status", "not run"), message=(known or {}).get("message", ""))
+        rows.append(row)
+    return rows
+
+
+def _numeric_axis(values: list):
+    """Axis values as numbers in the internal unit with that unit, when they are one kind of quantity."""
+    for dim, table in UNITS.items():
+        try:
+            return [parse_quantity(v, dim) for v in values], {"length": "mm", "force": "N", "pressure": "MPa",
+                                                               "wear_coefficient": "1/MPa"}[dim]
+        except UnitError:
+            continue
+    if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
+        return [float(v) for v in values], "1"
+    return None, None
+
+
+def write_table(sweep: Sweep, rows: list, outdir: Path) -> tuple[Path, Path]:
+    import csv
+
+    import h5py
+    import numpy as np
+
+    from fretsim.results import SUMMARY_UNITS
+    csv_path, h5_path = outdir / "table.csv", outdir / "table.h5"
+    keys = list(dict.fromkeys(k for r in rows for k in r))
+    tmp = outdir / ".table.csv.part"
+    with open(tmp, "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=keys)
+        w.writeheader()
+        w.writerows(rows)
+    os.replace(tmp, csv_path)
+    outputs = [k for k in SUMMARY_UNITS if any(k in r for r in rows)]
+    tmp = outdir / ".table.h5.part"
+    with h5py.File(tmp, "w") as f:
+        f.attrs["sweep"] = json.dumps(sweep.spec())
+        text = h5py.string_dtype()
+        if sweep.mode == "product":
+            dims = []
+            for k, vs in sweep.axes.items():
+                nums, units = _numeric_axis(vs)
+                ds = f.create_dataset(k, data=np.array(nums) if nums else np.array([str(v) for v in vs], dtype=object),
+                                      dtype=None if nums else text)
+                ds.make_scale(k)
+                ds.attrs["units"] = units or ""
+                ds.attrs["as_written"] = json.dumps([_text(v) for v in vs])
+                dims.append(ds)
+            shape = tuple(len(v) for v in sweep.axes.values())
+        else:
+            ds = f.create_dataset("point", data=np.arange(len(rows)))
+            ds.make_scale("point")
+            dims, shape = [ds], (len(rows),)
+            f.create_dataset("point_name", data=np.array([r["point"] for r in rows], dtype=object),
+                             dtype=text).dims[0].attach_scale(ds)
+            for k in dict.fromkeys(k for p in sweep.points for k in p.values):
+                vals = [r.get(k, "") for r in rows]
+                nums, units = _numeric_axis(vals)
+                c = f.create_dataset(k, data=np.array(nums) if nums else np.array(vals, dtype=object),
+                                     dtype=None if nums else text)
+                c.attrs["units"] = units or ""
+                c.dims[0].attach_scale(ds)
+        coords = " ".join(k for k in f if k not in ("point",)) if sweep.mode != "product" else ""
+        for name, data, dtype in ([("status", [r["status"] for r in rows], text)] +
+                                  [(k, [r.get(k, float("nan")) for r in rows], float) for k in outputs]):
+            arr = np.array(data, dtype=object if dtype is text else float).reshape(shape)
+            ds = f.create_dataset(name, data=arr, dtype=text if dtype is text else None)
+            for axis, scale in enumerate(dims):
+                ds.dims[axis].attach_scale(scale)
+            ds.attrs["units"] = SUMMARY_UNITS.get(name, "")
+            if coords:
+                ds.attrs["coordinates"] = coords
+    os.replace(tmp, h5_path)
+    return csv_path, h5_path

@@ -1,0 +1,117 @@
+"""What a sweep costs beyond its points' own work, and how it scales: the load × stroke sweep of the McColl case
+in 2D (cases/sweeps/mccoll_load_stroke.yaml, 20 points).
+
+* per-point overhead: the sweep's wall time over the sum of its points' loop times, with one worker, against
+  a shell loop that starts `fretsim run` for each point (process start-up and imports every time);
+* parallel efficiency: one worker against two;
+* the same sweep on a local Dask cluster (a scheduler and two worker processes on 127.0.0.1).
+
+    python scripts/bench_sweep.py [--out scripts/out]
+
+Prints a table and writes bench_sweep.csv.  Times are wall times of whole sweeps measured one after another in
+this process; the machine is shared, so compare the ratios.  fretsim's imports (~1.5 s, paid once per sweep, not
+per point) are done before the clock starts, so the overheads are the steady per-point costs: mostly writing each
+point's results file (an HDF5 image of ~80 datasets and ~230 attributes, timed separately below).
+"""
+from __future__ import annotations
+
+import argparse
+import csv
+import shutil
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from _study import ROOT, write_csv
+
+import fretsim.api  # noqa: F401 - the one-off import cost stays out of the per-point figures
+from fretsim.sweep import load_sweep, run_sweep
+
+SWEEP = ROOT / "cases" / "sweeps" / "mccoll_load_stroke.yaml"
+
+
+def loop_seconds(outdir: Path) -> float:
+    with open(outdir / "table.csv", newline="") as fh:
+        return sum(float(r["wall_time_s"]) for r in csv.DictReader(fh))
+
+
+def image_ms(sweep, tmp: Path, count: int = 5) -> float:
+    """Mean time to build a point's results file in memory (its run's final flush), over a few points run here."""
+    from fretsim.results import ResultsWriter
+    from fretsim.sweep import run_point
+    spent = []
+    real = ResultsWriter.image
+
+    def timed(self):
+        t = time.perf_counter()
+        data = real(self)
+        spent.append(time.perf_counter() - t)
+        return data
+
+    ResultsWriter.image = timed
+    try:
+        for p in sweep.points[:count]:
+            run_point((p.name, sweep.base_text, sweep.base_source, (*sweep.shared, *p.overrides),
+                       tmp / f"image-{p.name}.h5", "run"))
+    finally:
+        ResultsWriter.image = real
+    return 1e3 * sum(spent) / len(spent)
+
+
+def timed_sweep(outdir: Path, **kw) -> float:
+    shutil.rmtree(outdir, ignore_errors=True)
+    t = time.perf_counter()
+    run_sweep(load_sweep(SWEEP), outdir, **kw)
+    return time.perf_counter() - t
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "out")
+    args = ap.parse_args()
+    tmp = Path(tempfile.mkdtemp(prefix="bench-sweep-"))
+    sweep = load_sweep(SWEEP)
+    rows = []
+    one = timed_sweep(tmp / "one", jobs=1)
+    loops = loop_seconds(tmp / "one")
+    rows.append({"how": "sweep, 1 worker", "seconds": round(one, 2), "points": len(sweep.points),
+                 "overhead_over_loops": round(one / loops - 1, 3)})
+    write_ms = image_ms(sweep, tmp)
+    two = timed_sweep(tmp / "two", jobs=2)
+    rows.append({"how": "sweep, 2 workers", "seconds": round(two, 2), "points": len(sweep.points),
+                 "speed_up": round(one / two, 2)})
+    t = time.perf_counter()
+    for p in sweep.points:  # what users did before: one process per point
+        subprocess.run([sys.executable, "-m", "fretsim", "run", str(ROOT / "cases" / "mccoll_185N.yaml"), "-o",
+                        str(tmp / f"{p.name}.h5"), "--quiet", *[a for o in (*sweep.shared, *p.overrides)
+                                                                for a in ("--set", o)]],
+                       check=True, capture_output=True)
+    shell = time.perf_counter() - t
+    rows.append({"how": "shell loop of fretsim run, 1 process each", "seconds": round(shell, 2),
+                 "points": len(sweep.points), "overhead_over_loops": round(shell / loops - 1, 3)})
+    try:
+        import distributed
+        with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                      dashboard_address=None) as cluster:
+            dask = timed_sweep(tmp / "dask", dask=cluster.scheduler_address)
+        rows.append({"how": "local Dask cluster, 2 workers", "seconds": round(dask, 2), "points": len(sweep.points),
+                     "speed_up": round(one / dask, 2)})
+    except ImportError:
+        print("distributed is not installed: no Dask figure (pip install 'fretsim[dask]')")
+    print(f"{len(sweep.points)} points of {SWEEP.name}; the points' own loops take {loops:.2f} s in all "
+          f"({1e3 * loops / len(sweep.points):.0f} ms a point); building a point's results file takes {write_ms:.0f} ms "
+          f"({write_ms * len(sweep.points) / 1e3 / loops:.0%} of the loops)")
+    rows.append({"how": "results file image per point (ms)", "seconds": round(write_ms / 1e3, 4),
+                 "points": len(sweep.points), "overhead_over_loops": round(write_ms * len(sweep.points) / 1e3 / loops, 3)})
+    for r in rows:
+        extra = (f"overhead {r['overhead_over_loops']:.0%} over the loops" if "overhead_over_loops" in r else
+                 f"{r['speed_up']:.2f}× one worker")
+        print(f"  {r['how']:44s} {r['seconds']:7.2f} s  {extra}")
+    write_csv(rows, args.out / "bench_sweep.csv")
+    shutil.rmtree(tmp, ignore_errors=True)
+
+
+if __name__ == "__main__":
+    main()

@@ -1,0 +1,182 @@
+"""Sweeps (issue #10): sweep files checked like cases, long-lived workers, a table, resumable, Dask."""
+import csv
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+import numpy as np
+import pytest
+from click.testing import CliRunner
+
+from fretsim.case import CaseError
+from fretsim.cli import main
+from fretsim.results import FIELDS, read_results
+from fretsim.sweep import load_sweep, point_name, run_sweep
+
+CASES = Path(__file__).resolve().parent.parent / "cases"
+SMALL = f"""
+base: {CASES / 'mccoll_185N.yaml'}
+set: [model.dimension=2d, loading.cycles=400, "output.snapshots=[400]"]
+axes:
+  loading.normal_load: [150 N, 185 N]
+  loading.stroke: [10 um, 25 um]
+"""
+
+
+def sweep_file(tmp_path, text=SMALL, name="s.yaml"):
+    path = tmp_path / name
+    path.write_text(text)
+    return path
+
+
+def table(outdir):
+    with open(outdir / "table.csv", newline="") as fh:
+        return list(csv.DictReader(fh))
+
+
+def same_arrays(a: Path, b: Path):
+    ra, rb = read_results(a), read_results(b)
+    for k in FIELDS:
+        assert np.array_equal(ra.fields[k], rb.fields[k]), k
+    for k in ra.history:
+        if k != "wall_time":
+            assert np.array_equal(ra.history[k], rb.history[k]), k
+
+
+@pytest.mark.parametrize("text, path", [
+    (SMALL.replace("loading.stroke: [10 um, 25 um]", "loading.stroke: [10 um, 25]"), "loading.stroke"),
+    (SMALL.replace("axes:", "axis:"), "axis"),
+    (SMALL.replace("150 N", "150 kg"), "loading.normal_load"),
+    (SMALL + "mode: zap\n", "mode"),
+    (SMALL.replace(str(CASES / "mccoll_185N.yaml"), "missing.yaml"), "base"),
+    (SMALL + "mode: zip\n", "axes"),  # zip of two lists of one length each is fine; of unequal lengths is not
+], ids=["bare-number", "unknown-key", "wrong-unit", "bad-mode", "missing-base", "zip-lengths"])
+def test_bad_sweep_files_exit_2_with_the_yaml_path_and_write_nothing(tmp_path, text, path):
+    if path == "axes":
+        text = text.replace("[10 um, 25 um]", "[10 um, 25 um, 50 um]")
+    r = CliRunner().invoke(main, ["sweep", str(sweep_file(tmp_path, text)), "-o", str(tmp_path / "out")])
+    assert r.exit_code == 2 and path in r.output and "Traceback" not in r.output, r.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_points_are_named_from_their_values_deterministically():
+    a = point_name({"loading.normal_load": "150 N", "loading.stroke": "10 um"})
+    assert a == point_name({"loading.normal_load": "150 N", "loading.stroke": "10 um"})
+    assert a != point_name({"loading.normal_load": "150 N", "loading.stroke": "25 um"})
+    assert a.startswith("normal_load=150N_stroke=10um-")
+
+
+def test_modes_product_zip_and_points_give_the_expected_points(tmp_path):
+    assert len(load_sweep(sweep_file(tmp_path)).points) == 4
+    assert len(load_sweep(sweep_file(tmp_path, SMALL + "mode: zip\n", "z.yaml")).points) == 2
+    pts = f"""base: {CASES / 'mccoll_185N.yaml'}
+points:
+  - {{jumping.eta: 0.1, jumping.max: 100}}
+  - {{jumping.eta: 1.0, jumping.max: 600}}
+"""
+    assert [p.values for p in load_sweep(sweep_file(tmp_path, pts, "p.yaml")).points] == [
+        {"jumping.eta": 0.1, "jumping.max": 100}, {"jumping.eta": 1.0, "jumping.max": 600}]
+
+
+@pytest.fixture(scope="module")
+def local_sweep(tmp_path_factory):
+    tmp = tmp_path_factory.mktemp("sweep")
+    out = tmp / "local"
+    res = run_sweep(load_sweep(sweep_file(tmp)), out, jobs=2)
+    return tmp, out, res
+
+
+def test_a_local_sweep_writes_a_results_file_per_point_and_one_table(local_sweep):
+    tmp, out, res = local_sweep
+    rows = table(out)
+    assert len(rows) == 4 and {r["status"] for r in rows} == {"complete"}
+    assert {(r["loading.normal_load"], r["loading.stroke"]) for r in rows} == {
+        ("150 N", "10 um"), ("150 N", "25 um"), ("185 N", "10 um"), ("185 N", "25 um")}
+    one = read_results(out / "points" / f"{rows[0]['point']}.h5")
+    assert f"loading.normal_load={rows[0]['loading.normal_load']}" in one.overrides  # the point's inputs recorded
+    depth = {(r["loading.normal_load"], r["loading.stroke"]): float(r["centre_wear_depth_stationary_um"]) for r in rows}
+    assert depth[("185 N", "25 um")] > depth[("150 N", "25 um")] and depth[("185 N", "25 um")] > depth[("185 N", "10 um")]
+
+
+def test_the_table_opens_in_xarray_with_the_axes_as_coordinates(local_sweep):
+    xr = pytest.importorskip("xarray")
+    _, out, _ = local_sweep
+    ds = xr.open_dataset(out / "table.h5", engine="h5netcdf")
+    d = ds.centre_wear_depth_stationary_um
+    assert d.dims == ("loading.normal_load", "loading.stroke")
+    assert list(ds["loading.stroke"].values) == [0.01, 0.025] and ds["loading.stroke"].attrs["units"] == "mm"
+
+
+def test_re_running_a_sweep_skips_complete_points(local_sweep):
+    tmp, out, _ = local_sweep
+    stamps = {p: p.stat().st_mtime_ns for p in (out / "points").iterdir()}
+    t = time.perf_counter()
+    run_sweep(load_sweep(tmp / "s.yaml"), out, jobs=2)
+    assert {p: p.stat().st_mtime_ns for p in (out / "points").iterdir()} == stamps
+    assert time.perf_counter() - t < 5
+
+
+def test_a_failing_point_is_recorded_and_the_others_complete(tmp_path):
+    text = SMALL.replace("axes:\n  loading.normal_load: [150 N, 185 N]\n  loading.stroke: [10 um, 25 um]\n",
+                         "mode: product\naxes:\n  jumping.linear: [5, 10000]\n") + "  jumping.scheme: [linear]\n"
+    r = CliRunner().invoke(main, ["sweep", str(sweep_file(tmp_path, text)), "-o", str(tmp_path / "o")])
+    assert r.exit_code == 3, r.output
+    rows = {r["jumping.linear"]: r for r in table(tmp_path / "o")}
+    assert rows["5"]["status"] == "complete"
+    assert rows["10000"]["status"] == "refused" and "stability limit" in rows["10000"]["message"]
+
+
+def test_response_curves_are_drawn_for_each_axis(local_sweep, tmp_path):
+    _, out, _ = local_sweep
+    r = CliRunner().invoke(main, ["plot", str(out), "-o", str(tmp_path / "figs")])
+    assert r.exit_code == 0, r.output
+    assert sorted(p.name for p in (tmp_path / "figs").iterdir()) == ["sweep_loading_normal_load.png",
+                                                                     "sweep_loading_stroke.png"]
+
+
+def test_a_sweep_killed_mid_way_loses_no_completed_point_and_ends_with_the_same_table(tmp_path, local_sweep):
+    _, reference, _ = local_sweep
+    text = SMALL.replace("loading.cycles=400", "loading.cycles=400")
+    path = sweep_file(tmp_path, text)
+    out = tmp_path / "killed"
+    proc = subprocess.Popen([sys.executable, "-m", "fretsim", "sweep", str(path), "-o", str(out), "--jobs", "1"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and len(list((out / "points").glob("*.h5"))) < 2:
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGKILL)  # the sweep and its workers, as a machine going down would
+    proc.wait()
+    done = {p.name for p in (out / "points").glob("*.h5") if read_results(p).status == "complete"}
+    run_sweep(load_sweep(path), out, jobs=2)
+    assert done <= {p.name for p in (out / "points").glob("*.h5")}
+    assert [r["point"] for r in table(out)] == [r["point"] for r in table(reference)]
+    for r in table(reference):
+        same_arrays(out / "points" / f"{r['point']}.h5", reference / "points" / f"{r['point']}.h5")
+
+
+def test_the_same_sweep_on_a_dask_cluster_gives_the_same_table_bit_for_bit(local_sweep):
+    distributed = pytest.importorskip("distributed")
+    tmp, reference, _ = local_sweep
+    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
+                                  dashboard_address=None) as cluster:
+        r = CliRunner().invoke(main, ["sweep", str(tmp / "s.yaml"), "-o", str(tmp / "dask"), "--dask",
+                                      cluster.scheduler_address])
+    assert r.exit_code == 0, r.output
+    local, remote = table(reference), table(tmp / "dask")
+    skip = {"wall_time_s"}
+    assert [{k: v for k, v in row.items() if k not in skip} for row in local] == \
+        [{k: v for k, v in row.items() if k not in skip} for row in remote]
+    for row in local:
+        same_arrays(reference / "points" / f"{row['point']}.h5", tmp / "dask" / "points" / f"{row['point']}.h5")
+
+
+def test_an_unreachable_dask_scheduler_is_a_clear_error(tmp_path, monkeypatch):
+    pytest.importorskip("distributed")
+    import fretsim.sweep
+    monkeypatch.setattr(fretsim.sweep, "DASK_CONNECT_TIMEOUT", "2s")
+    r = CliRunner().invoke(main, ["sweep", str(sweep_file(tmp_path)), "-o", str(tmp_path / "o"), "--dask",
+                                  "tcp://127.0.0.1:9"])
+    assert r.exit_code == 2 and "cannot reach the scheduler" in r.output
