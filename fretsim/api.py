@@ -3,6 +3,8 @@
     >>> from fretsim.api import load_case, run, read_results
     >>> outcome = run(load_case("cases/mccoll_185N.yaml"), "out.h5")
     >>> outcome.summary["centre_wear_depth_stationary_um"]
+    >>> table = sweep("cases/sweeps/mccoll_load_stroke.yaml", "load_stroke")   # every point, one table
+    >>> table.rows[0]["centre_wear_depth_stationary_um"], table.to_xarray()
 """
 from __future__ import annotations
 
@@ -55,6 +57,14 @@ class _Counter:
         self.last = step
         if step.is_snapshot:
             self.errors = (max(self.errors[0], step.error_depth), max(self.errors[1], step.error_pressure))
+
+
+def sweep(sweep_file: str | Path, outdir: str | Path, *, jobs: int = 0, dask: Optional[str] = None,
+          overwrite: bool = False, progress: Optional[Callable[[dict], None]] = None):
+    """Run every point of a sweep file into ``outdir`` (see :mod:`fretsim.sweep`) and return its table
+    (:class:`fretsim.sweep.SweepOutcome`: ``rows``, ``counts``, ``to_pandas()``, ``to_xarray()``)."""
+    from fretsim.sweep import load_sweep, run_sweep
+    return run_sweep(load_sweep(sweep_file), outdir, jobs=jobs, dask=dask, overwrite=overwrite, progress=progress)
 
 
 def check(case: Case) -> tuple[Setup, Case, Plan]:

@@ -230,7 +230,7 @@ class TubeOnFlat(Geometry):
 
 
 @dataclass(frozen=True)
-class RollerOnFlat(Geometry):
+class RollerOnFlat(CylinderOnFlat):
     """A roller of radius R and length L whose axial profile drops by d(y) from the middle: crowned (a crown
     radius: d = y²/2R_c), edge-rounded (flat over a middle length, then circular: d = (|y| − l/2)²/2r_e), or
     tabulated (d at points along y, interpolated linearly, mirrored if given for y ≥ 0 only) — what designers
@@ -245,9 +245,7 @@ class RollerOnFlat(Geometry):
     profile_y: Optional[tuple] = None  # mm
     profile_drop: Optional[tuple] = None  # mm
 
-    @property
-    def line_length(self) -> float:
-        return self.length
+    # a cylinder's Hertz estimate, limits and scar estimate: the profile only relieves its ends
 
     def drop(self, y: np.ndarray) -> np.ndarray:
         y = np.abs(np.asarray(y, dtype=float))
@@ -266,17 +264,6 @@ class RollerOnFlat(Geometry):
 
     def separation(self, grid: Grid) -> np.ndarray:
         return _line_gap(grid, self.radius, self.length, None if grid.plane_strain else self.drop(grid.y))
-
-    def hertz(self, load: float, e_star: float) -> HertzEstimate:
-        h = hertz_line(load / self.length, self.radius, e_star)
-        return HertzEstimate(h.half_width, self.length / 2, h.peak_pressure, True)
-
-    @property
-    def limits(self) -> Limits:
-        return Limits(self.radius, self.radius / 2, None, f"its radius {self.radius:.4g} mm")
-
-    def scar_half_widths(self, volume: float) -> tuple[float, float]:
-        return (1.5 * self.radius * volume / self.length) ** (1 / 3), self.length / 2
 
 
 GEOMETRIES: dict[str, type] = {g.kind: g for g in (CylinderOnFlat, BallOnFlat, CrossedCylinders, TubeOnFlat,

@@ -12,7 +12,6 @@ which preserves the wear volume exactly.
 from __future__ import annotations
 
 import numpy as np
-from scipy.interpolate import Akima1DInterpolator
 
 from fretsim.grid import Grid
 
@@ -52,6 +51,7 @@ def _redistribute(forces: np.ndarray, src: np.ndarray, dst: np.ndarray) -> np.nd
     if src.size < 3:
         fine = np.array([np.interp(dst, src, w) for w in weights])
     else:
+        from scipy.interpolate import Akima1DInterpolator  # only refined runs need it (~0.2 s to import)
         fine = Akima1DInterpolator(src, weights, axis=1, extrapolate=True)(dst)
     fine = np.clip(np.nan_to_num(fine), 0.0, None)
     sums = fine.sum(axis=1, keepdims=True)

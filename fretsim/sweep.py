@@ -169,27 +169,50 @@ def load_sweep(path: str | Path) -> Sweep:
 
 # --- running the points ------------------------------------------------------------------------------------------
 
+_IN_POINT = False  # a worker is inside a point's run (its SIGTERM then ends the run cleanly)
+
+
+_STOPPING = False  # a worker was told to stop: it starts no further point (some may be queued already)
+
+
+def _on_terminate(signum, frame) -> None:
+    global _STOPPING
+    _STOPPING = True
+    if _IN_POINT:
+        raise KeyboardInterrupt  # the run writes its file with status interrupted and releases its output
+    os._exit(0)  # idle: nothing to save
+
+
 def _init_worker() -> None:
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ[var] = "1"
-    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent stops the sweep; workers finish or are ended
+    signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent stops the sweep; workers are ended by SIGTERM
+    signal.signal(signal.SIGTERM, _on_terminate)
 
 
 def run_point(task: tuple) -> dict:
     """Run (or resume) one point, writing its results file; returns the point's status.  In a worker process."""
+    global _IN_POINT
     name, base_text, base_source, overrides, output, mode = task
+    if _STOPPING:
+        return {"name": name, "status": "not run", "message": "the sweep was stopped first"}
     from fretsim.api import resume, run
     try:
+        _IN_POINT = True
         if mode == "resume":
             outcome = resume(output)
         else:
             case = parse_case(base_text, source=base_source, overrides=list(overrides))
             outcome = run(case, output, overwrite=True)
         return {"name": name, "status": outcome.status, "message": outcome.message, "summary": outcome.summary}
+    except KeyboardInterrupt:
+        return {"name": name, "status": "interrupted", "message": "the sweep was stopped; re-run it to resume"}
     except CaseError as exc:
         return {"name": name, "status": "refused", "message": str(exc)}
     except Exception as exc:  # noqa: BLE001 - a point's failure is recorded, the sweep goes on
         return {"name": name, "status": "failed", "message": f"{type(exc).__name__}: {exc}"}
+    finally:
+        _IN_POINT = False
 
 
 def run_point_remote(task: tuple) -> dict:
@@ -290,9 +313,12 @@ def _run_local(tasks: list, jobs: int, progress) -> list:
             if progress is not None:
                 progress(r)
     except BaseException:
+        workers = list((getattr(pool, "_processes", None) or {}).values())  # shutdown forgets them
         pool.shutdown(wait=False, cancel_futures=True)
-        for proc in list(getattr(pool, "_processes", {}).values()):
+        for proc in workers:
             proc.terminate()  # SIGTERM: a running point records itself as interrupted, and resumes next time
+        for proc in workers:
+            proc.join(timeout=60)  # its last write done before the table reads its file
         raise
     pool.shutdown(wait=True)
     return results

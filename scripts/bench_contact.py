@@ -6,6 +6,10 @@ Columns: cold time, warm time after a small wear-like gap change, iterations, er
 against Hertz (ball) or against the finest cylinder grid (cylinder), and the largest pressure difference to
 fretsim's cg on the same grid (same discrete problem → small).  One thread everywhere.
 
+In the loop (issue #9): the cost of a contact solve inside a default run (185 N, 18 000 cycles, and Kirk,
+10⁶ cycles, both 3D), where each solve starts from the previous pressure and solves only a window around the
+contact: time and CG iterations per solve, beside a cold solve of the first step's problem on the same grid.
+
     python scripts/bench_contact.py [--quick] [--out scripts/out]
 """
 import os
@@ -20,7 +24,7 @@ from pathlib import Path  # noqa: E402
 
 import numpy as np  # noqa: E402
 
-from fretsim.compliance import Compliance  # noqa: E402
+from fretsim.compliance import HalfSpace as Compliance  # noqa: E402
 from fretsim.grid import Grid  # noqa: E402
 from fretsim.reference import effective_modulus, hertz_line, hertz_point  # noqa: E402
 from fretsim.solvers import solve  # noqa: E402
@@ -159,7 +163,47 @@ def main():
         w.writeheader()
         w.writerows(rows)
     chart(rows, out / "bench_contact.png")
-    print(f"# wrote {out / 'bench_contact.csv'} and {out / 'bench_contact.png'}")
+    loop_rows = [in_loop(case) for case in (("mccoll_185N",) if args.quick else ("mccoll_185N", "kirk_450N_20Hz"))]
+    with open(out / "bench_contact_in_loop.csv", "w", newline="") as fh:
+        w = csv.DictWriter(fh, fieldnames=list(loop_rows[0]))
+        w.writeheader()
+        w.writerows(loop_rows)
+    print(f"# wrote {out / 'bench_contact.csv'}, {out / 'bench_contact_in_loop.csv'} and {out / 'bench_contact.png'}")
+
+
+def in_loop(name: str) -> dict:
+    """Time every contact solve of a default 3D run (the loop's own calls) against a cold solve."""
+    import fretsim.simulate as sim
+    from fretsim.case import load_case
+    from fretsim.plan import prepare
+    setup, _, _ = prepare(load_case(Path(__file__).resolve().parent.parent / "cases" / f"{name}.yaml"))
+    calls = []
+    real = sim.solve
+
+    def timed(op, gap, load, **kw):
+        t = time.perf_counter()
+        res = real(op, gap, load, **kw)
+        calls.append((time.perf_counter() - t, res.iterations, op, gap, load, kw))
+        return res
+
+    sim.solve = timed
+    try:
+        t = time.perf_counter()
+        sim.simulate(setup, ())
+        loop = time.perf_counter() - t
+    finally:
+        sim.solve = real
+    _, _, op, gap, load, kw = calls[1]  # the first wear step's problem, solved from nothing
+    cold_t, cold = best_time(lambda: real(op, gap, load, method=kw.get("method", "cg"), tol=kw.get("tol", TOL)), 3)
+    per = sum(c[0] for c in calls) / len(calls)
+    row = {"case": name, "grid": f"{setup.grid.shape[1]}x{setup.grid.shape[0]}", "loop_s": round(loop, 3), "solves": len(calls),
+           "solve_share": round(sum(c[0] for c in calls) / loop, 3), "in_loop_ms": round(1e3 * per, 2),
+           "in_loop_iterations": round(sum(c[1] for c in calls) / len(calls), 1), "cold_ms": round(1e3 * cold_t, 2),
+           "cold_iterations": cold.iterations}
+    print(f"in the loop, {name} 3D ({row['grid']}): {row['solves']} solves in {loop:.2f} s ({row['solve_share']:.0%} "
+          f"of the loop); {row['in_loop_ms']:.2f} ms and {row['in_loop_iterations']} CG iterations a solve, "
+          f"against {row['cold_ms']:.2f} ms and {cold.iterations} iterations cold")
+    return row
 
 
 def chart(rows, path):

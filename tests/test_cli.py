@@ -84,3 +84,23 @@ def test_summary_of_a_non_results_file_is_a_clear_error(cli, tmp_path):
 def test_linear_jump_beyond_the_limit_exits_2_with_the_limit(cli, tmp_path):
     r = cli.invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), "-o", "u.h5", "--set", "jumping.linear=80"])
     assert r.exit_code == 2 and "stability limit" in r.output and not (tmp_path / "u.h5").exists()
+
+
+def test_the_readmes_case_and_sweep_examples_are_valid_as_printed(tmp_path):
+    import re
+    from fretsim.case import parse_case
+    from fretsim.sweep import load_sweep
+    readme = (Path(__file__).resolve().parent.parent / "README.md").read_text()
+    blocks = re.findall(r"```yaml\n(.*?)```", readme, flags=re.S)
+    case_blocks = [b for b in blocks if "geometry:" in b]
+    sweep_blocks = [b for b in blocks if "axes:" in b]
+    assert case_blocks and sweep_blocks
+    for text in case_blocks:
+        assert parse_case(text, source="README").cycles > 0
+    cases = Path(__file__).resolve().parent.parent / "cases"
+    (tmp_path / "mccoll_185N.yaml").write_text((cases / "mccoll_185N.yaml").read_text())
+    for text in sweep_blocks:  # its base is relative to cases/sweeps/, where the README says it lives
+        sweep = tmp_path / "sweeps" / "s.yaml"
+        sweep.parent.mkdir(exist_ok=True)
+        sweep.write_text(text)
+        assert len(load_sweep(sweep).points) == 20

@@ -139,8 +139,7 @@ def test_response_curves_are_drawn_for_each_axis(local_sweep, tmp_path):
 
 def test_a_sweep_killed_mid_way_loses_no_completed_point_and_ends_with_the_same_table(tmp_path, local_sweep):
     _, reference, _ = local_sweep
-    text = SMALL.replace("loading.cycles=400", "loading.cycles=400")
-    path = sweep_file(tmp_path, text)
+    path = sweep_file(tmp_path)
     out = tmp_path / "killed"
     proc = subprocess.Popen([sys.executable, "-m", "fretsim", "sweep", str(path), "-o", str(out), "--jobs", "1"],
                             stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, start_new_session=True)
@@ -180,3 +179,41 @@ def test_an_unreachable_dask_scheduler_is_a_clear_error(tmp_path, monkeypatch):
     r = CliRunner().invoke(main, ["sweep", str(sweep_file(tmp_path)), "-o", str(tmp_path / "o"), "--dask",
                                   "tcp://127.0.0.1:9"])
     assert r.exit_code == 2 and "cannot reach the scheduler" in r.output
+
+
+def test_the_api_sweep_returns_the_table_the_cli_writes(tmp_path):
+    from fretsim.api import sweep
+    out = sweep(sweep_file(tmp_path), tmp_path / "api", jobs=1)
+    with open(out.table_csv, newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [r["point"] for r in rows] == [r["point"] for r in out.rows] and out.all_complete
+    for row, written in zip(out.rows, rows):
+        assert float(written["centre_wear_depth_stationary_um"]) == pytest.approx(
+            row["centre_wear_depth_stationary_um"], rel=1e-12)
+
+
+def test_ctrl_c_stops_a_sweep_at_once_with_its_points_interrupted_and_a_rerun_completes_them(tmp_path):
+    # single-cycle steps: each point takes seconds, so the interrupt lands inside the points
+    text = SMALL.replace('"output.snapshots=[400]"', '"output.snapshots=[3000]", jumping.scheme=linear, '
+                                                     'jumping.linear=1').replace("loading.cycles=400",
+                                                                                "loading.cycles=3000")
+    path = sweep_file(tmp_path, text)
+    out = tmp_path / "stopped"
+    proc = subprocess.Popen([sys.executable, "-m", "fretsim", "sweep", str(path), "-o", str(out), "--jobs", "2"],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True, start_new_session=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and not list((out / "points").glob("*.h5")):
+        time.sleep(0.05)
+    os.killpg(proc.pid, signal.SIGINT)  # what Ctrl-C sends: the sweep and its workers
+    t = time.monotonic()
+    output, _ = proc.communicate(timeout=60)
+    assert proc.returncode == 130 and "run the same command again" in output and "Traceback" not in output, output
+    assert time.monotonic() - t < 10  # no queued point is started after the interrupt
+    with pytest.raises(ProcessLookupError):
+        os.killpg(proc.pid, 0)  # no worker left behind
+    statuses = [r["status"] for r in table(out)]
+    assert "interrupted" in statuses and set(statuses) <= {"interrupted", "not run", "complete"}, statuses
+    assert not [p.name for p in (out / "points").iterdir() if p.name.startswith(".")]  # no lock, no temporary
+    r = CliRunner().invoke(main, ["sweep", str(path), "-o", str(out), "--jobs", "2"])
+    assert r.exit_code == 0, r.output
+    assert {row["status"] for row in table(out)} == {"complete"}
