@@ -320,12 +320,18 @@ def plot(results_file: Path, outdir: Path | None, fmt: str, dpi: int, log_cycles
     except ValueError as exc:
         _fail(str(exc), EXIT_BAD_INPUT, debug)
     from fretsim.plotting import plot_all
+    _write_and_list(lambda: plot_all(res, outdir or results_file.parent, fmt=fmt, dpi=dpi, log_cycles=log_cycles),
+                    "figures", debug)
+
+
+def _write_and_list(write, what: str, debug: bool) -> None:
+    """Run a writer of files and print their paths; bad data is exit 2, a refusing disk exit 5, no traceback."""
     try:
-        paths = plot_all(res, outdir or results_file.parent, fmt=fmt, dpi=dpi, log_cycles=log_cycles)
+        paths = write()
     except ValueError as exc:
         _fail(str(exc), EXIT_BAD_INPUT, debug)
     except OSError as exc:
-        _fail(f"cannot write figures: {exc.strerror or exc}", EXIT_IO, debug)
+        _fail(f"cannot write {what}: {exc.strerror or exc}", EXIT_IO, debug)
     for p in paths:
         click.echo(str(p))
 
@@ -340,14 +346,7 @@ def export(results_file: Path, csv_dir: Path, debug: bool) -> None:
     from fretsim.export import export_csv
     from fretsim.results import read_results
 
-    try:
-        paths = export_csv(read_results(results_file), csv_dir)
-    except ValueError as exc:
-        _fail(str(exc), EXIT_BAD_INPUT, debug)
-    except OSError as exc:
-        _fail(f"cannot write {csv_dir}: {exc.strerror or exc}", EXIT_IO, debug)
-    for p in paths:
-        click.echo(str(p))
+    _write_and_list(lambda: export_csv(read_results(results_file), csv_dir), str(csv_dir), debug)
 
 
 @main.command()
