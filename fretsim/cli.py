@@ -8,6 +8,7 @@ Each command imports what it needs when it runs, so `--help`, `summary` and `che
 """
 from __future__ import annotations
 
+import os
 import sys
 import traceback
 from pathlib import Path
@@ -297,8 +298,11 @@ def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> N
 @click.option("--format", "fmt", type=click.Choice(["png", "pdf", "svg"]), default="png", show_default=True)
 @click.option("--dpi", type=click.IntRange(50, 1200), default=150, show_default=True)
 @click.option("--log", "log_cycles", is_flag=True, help="Logarithmic cycle axis for the histories.")
+@click.option("--jobs", type=click.IntRange(1, 2), default=None,
+              help="Processes rendering the figures: 2 on a machine with 2 or more cores (default), else 1.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
-def plot(results_file: Path, outdir: Path | None, fmt: str, dpi: int, log_cycles: bool, debug: bool) -> None:
+def plot(results_file: Path, outdir: Path | None, fmt: str, dpi: int, log_cycles: bool, jobs: int | None,
+         debug: bool) -> None:
     """Write figures of RESULTS_FILE: wear profiles across and along the contact, wear and pressure maps,
     pressure profiles with the initial Hertz solution, depth and volume against cycles.  Given a sweep's
     directory: response curves, each output against each swept axis, one line per value of the others."""
@@ -320,8 +324,9 @@ def plot(results_file: Path, outdir: Path | None, fmt: str, dpi: int, log_cycles
     except ValueError as exc:
         _fail(str(exc), EXIT_BAD_INPUT, debug)
     from fretsim.plotting import plot_all
-    _write_and_list(lambda: plot_all(res, outdir or results_file.parent, fmt=fmt, dpi=dpi, log_cycles=log_cycles),
-                    "figures", debug)
+    jobs = jobs or (2 if (os.cpu_count() or 1) > 1 else 1)
+    _write_and_list(lambda: plot_all(res, outdir or results_file.parent, fmt=fmt, dpi=dpi, log_cycles=log_cycles,
+                                     jobs=jobs), "figures", debug)
 
 
 def _write_and_list(write, what: str, debug: bool) -> None:

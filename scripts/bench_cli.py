@@ -53,6 +53,7 @@ def main() -> None:
         "fretsim summary r.h5": [*fretsim, "summary", "r.h5"],
         "fretsim check mccoll_185N.yaml": [*fretsim, "check", str(CASE)],
         "fretsim plot r.h5 (3D, 4 PNG figures)": [*fretsim, "plot", "r.h5", "-o", "figs"],
+        "fretsim plot r.h5 --jobs 1 (one process)": [*fretsim, "plot", "r.h5", "-o", "figs1", "--jobs", "1"],
         "fretsim run mccoll_185N.yaml (3D, 18 000 cycles)": [*fretsim, "run", str(CASE), "-o", "run.h5",
                                                             "--overwrite", "--quiet"],
     }

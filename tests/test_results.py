@@ -2,6 +2,7 @@
 import ast
 import csv
 import json
+import os
 import subprocess
 import sys
 import warnings
@@ -110,6 +111,30 @@ def test_a_contact_only_run_draws_only_what_it_has(tmp_path):
     out = tmp_path / "c0.h5"
     run(load_case(CASE, ["model.dimension=2d", "loading.cycles=0"]), out)
     assert set(figures(read_results(out))) == {"pressure_profiles"}
+
+
+def test_figures_rendered_in_a_forked_helper_are_byte_identical_to_sequential_ones(results_3d, tmp_path):
+    from fretsim.plotting import plot_all
+    res = read_results(results_3d)
+    one = plot_all(res, tmp_path / "one", jobs=1)
+    two = plot_all(res, tmp_path / "two", jobs=2)
+    assert [p.name for p in one] == [p.name for p in two] and len(one) == 4
+    assert all(a.read_bytes() == b.read_bytes() for a, b in zip(one, two))
+
+
+def test_a_failing_forked_helper_leaves_its_figures_to_the_parent(results_3d, tmp_path, monkeypatch):
+    import fretsim.plotting as plotting
+    real = plotting._maps
+    parent = os.getpid()
+
+    def maps_failing_in_the_child(res):
+        if os.getpid() != parent:
+            raise RuntimeError("the helper breaks")
+        return real(res)
+
+    monkeypatch.setattr(plotting, "_maps", maps_failing_in_the_child)
+    paths = plotting.plot_all(read_results(results_3d), tmp_path, jobs=2)
+    assert all(p.stat().st_size > 10_000 for p in paths) and len(paths) == 4
 
 
 def test_plot_writes_the_format_asked_for(results_3d, tmp_path):
