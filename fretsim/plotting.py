@@ -111,10 +111,14 @@ def plot_all(res: Results, outdir: str | Path, fmt: str = "png", dpi: int = 150,
     def save(subset):
         for name in subset:
             fig = figures(res, log_cycles, (name,))[name]
+            # a figure appears whole or not at all: a full disk never leaves a truncated one over a good one
+            tmp = outdir / f".{paths[name].name}.{os.getpid()}.tmp"
             try:
-                fig.savefig(paths[name], dpi=dpi)
+                fig.savefig(tmp, dpi=dpi, format=fmt)
+                os.replace(tmp, paths[name])
             finally:
                 plt.close(fig)
+                tmp.unlink(missing_ok=True)
 
     # fork only a single-threaded process: a lock held by another thread would stay locked in the child
     helper = [n for n in names if n in _FORKED] if jobs > 1 and hasattr(os, "fork") \

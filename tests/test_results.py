@@ -137,6 +137,27 @@ def test_a_failing_forked_helper_leaves_its_figures_to_the_parent(results_3d, tm
     assert all(p.stat().st_size > 10_000 for p in paths) and len(paths) == 4
 
 
+def test_a_disk_that_fills_while_plotting_leaves_earlier_figures_whole_and_no_temporaries(results_3d, tmp_path,
+                                                                                            monkeypatch):
+    import errno
+
+    from matplotlib.figure import Figure
+
+    from fretsim.plotting import plot_all
+    res = read_results(results_3d)
+    good = plot_all(res, tmp_path, jobs=1)
+    before = {p.name: p.read_bytes() for p in good}
+
+    def full_disk(self, fname, **kw):
+        Path(fname).write_bytes(b"\x89PNG truncated")
+        raise OSError(errno.ENOSPC, "No space left on device")
+
+    monkeypatch.setattr(Figure, "savefig", full_disk)
+    with pytest.raises(OSError):
+        plot_all(res, tmp_path, jobs=2)
+    assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
+
+
 def test_plot_writes_the_format_asked_for(results_3d, tmp_path):
     r = CliRunner().invoke(main, ["plot", str(results_3d), "-o", str(tmp_path), "--format", "svg", "--dpi", "100",
                                   "--log"])
