@@ -1,16 +1,21 @@
 """PROTOTYPE, NOT VERIFIED, NOT USED BY FRETSIM: the paper's finite-space model of the flat (section 2.1,
 Fig. 2; Zhang et al. and Stan et al.), kept for the next step of issue #8.
 
-Run as a script it builds the correction on the McColl 185 N grid and runs the case with it, beside the plain
-half-space, for comparison with the independent finite-element result of ``study_free_faces_fe.py``.  Measured
-(2026-11-22): this normal-stress-only model moves the flat's centre-line depth +0.03 % and the maximum depths
-−0.02 %, and the end pressure peak at N = 0 from 1.192 to 1.187 × the centre; the FE block gives +0.39 %,
-−1.4 % and 1.053.  It changes the end element's own compliance by 0.9 %, and its correction is 20 % asymmetric before it is
-symmetrised (the neglected shear breaks reciprocity).  So, if this prototype is right, the
-paper's approximation captures a few per cent of the faces' effect: on the face plane the half-space's vertical
-shear τ_yz, which the method neglects, is what carried the edge's load (it exceeds the normal stress σ_yy that
-the method corrects: −0.28 p against −0.21 p at the first face row, measured with these kernels).  Its kernels follow Boussinesq's point-load formulas (Johnson, Contact Mechanics, 3.20–3.21)
-but nothing here checks them independently: verify before building on it.
+Run as a script it builds the correction on the McColl 185 N grid and runs the case with it beside the plain
+half-space, for comparison with ``study_free_faces_fe.py``.  Measured (2026-11-22), as changes of the flat's
+centre-line depth, the maximum depths and the end/centre pressure at N = 0 (1.192 on a half-space):
+
+    this prototype (normal stress on the faces only)          +0.03 %   −0.02 %   1.187
+    the paper's approximation solved by FE (shear-only plane)  +0.08 %   −0.28 %   1.158
+    free faces, FE                                             +0.39 %   −1.4 %    1.053
+
+The prototype changes the end element's own compliance by 0.9 %; its correction is 20 % asymmetric before it
+is symmetrised (the neglected shear breaks reciprocity).  It and the FE solution of the same approximation
+disagree by a factor of about 5 on a small effect, and both leave out most of the faces' effect: on the face
+plane the half-space's vertical shear τ_yz, which the method neglects, exceeds the normal stress σ_yy it
+corrects (−0.28 p against −0.21 p at the first face row, with these kernels).  The kernels follow
+Boussinesq's point-load formulas (Johnson, Contact Mechanics, 3.20–3.21), but nothing here checks them
+independently: verify before building on it.
 
 A flat of finite width: the extra compliance of its free side faces (paper §2.1, Fig. 2).
 

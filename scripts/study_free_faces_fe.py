@@ -12,6 +12,9 @@ effect alone (the finite depth and the fixed bottom are common to both and cance
 added to fretsim's half-space compliance as one more operator.  Then the 185 N case runs in 3D with and
 without it, through fretsim's own loop.
 
+Last, the paper's approximation itself is solved the same way: planes at the faces that carry shear but no
+normal stress (material beyond them kept), to show how much of the faces' effect the shear carries.
+
 Checks of the comparator itself: the block under p = cos(kx) over its whole width against the half-space's
 exact 2(1 − ν²)/(E k) far from its faces, and the correction's convergence in the number of Fourier modes and
 under mesh refinement.
@@ -58,7 +61,7 @@ class Block:
     """
 
     def __init__(self, y_nodes: np.ndarray, depth: float, h0: float, youngs: float, poisson: float,
-                 growth: float = 1.3):
+                 growth: float = 1.3, release: tuple[float, float] | None = None, keep_shear: bool = True):
         from skfem import Basis, BilinearForm, ElementQuad2, ElementVector, MeshQuad, asm
 
         z = -np.concatenate([[0.0], np.cumsum(_graded(h0, growth, depth / 8, depth))])[::-1]
@@ -76,9 +79,17 @@ class Block:
                 e = (k * su[0], gu[1][0], gu[2][1], gu[1][1] + gu[2][0], gu[0][0] - k * su[1], gu[0][1] - k * su[2])
                 f = (k * sv[0], gv[1][0], gv[2][1], gv[1][1] + gv[2][0], gv[0][0] - k * sv[1], gv[0][1] - k * sv[2])
                 # strains: εxx, εyy, εzz, γyz (cos kx) and γxy, γxz (sin kx); a period averages both alike
-                return (lam * (e[0] + e[1] + e[2]) * (f[0] + f[1] + f[2])
+                full = (lam * (e[0] + e[1] + e[2]) * (f[0] + f[1] + f[2])
                         + 2 * mu * (e[0] * f[0] + e[1] * f[1] + e[2] * f[2])
                         + mu * (e[3] * f[3] + e[4] * f[4] + e[5] * f[5]))
+                if release is None:
+                    return full
+                # a layer across y (release[0] < |y| < release[1]) that carries the shears γyz, γxy across it
+                # but no normal stress σyy: the paper's approximation (a stiffness 1e-6 of the rest keeps the
+                # layer's other modes from being free)
+                layer = (np.abs(w.x[0]) > release[0]) & (np.abs(w.x[0]) < release[1])
+                shear = mu * (e[3] * f[3] + e[4] * f[4]) if keep_shear else 0.0
+                return np.where(layer, shear + 1e-6 * full, full)
             return asm(form, b)
 
         k0, kp, km = form_at(0.0), form_at(1.0), form_at(-1.0)
@@ -123,14 +134,23 @@ def check_against_the_half_space(youngs: float, poisson: float) -> list[tuple[fl
 
 
 def face_correction(rows: np.ndarray, dy: float, youngs: float, poisson: float, ks: np.ndarray, split: int,
-                    h0: float, depth: float = DEPTH) -> np.ndarray:
-    """ΔG[m, i, j]: settlement at row i's centre per unit cos(k_m x) pressure on row j, faces minus wide block."""
+                    h0: float, depth: float = DEPTH, released: bool = False, keep_shear: bool = True) -> np.ndarray:
+    """ΔG[m, i, j]: settlement at row i's centre per unit cos(k_m x) pressure on row j, faces minus wide block.
+
+    ``released``: instead of free faces, planes at the faces that carry shear but no normal stress (what the
+    paper's overlapping half-spaces model, shear on the overlaps neglected), minus the same mesh without them;
+    with ``keep_shear`` False the planes carry nothing, which must reproduce the free faces (a check)."""
     half = rows.size * dy / 2
     edges = -half + dy * np.arange(rows.size + 1)
     inner = np.linspace(-half, half, rows.size * split + 1)
     outside = half + np.cumsum(_graded(dy / split, 1.3, 1.0, (WIDE - 1) * half))
-    blocks = {"faces": Block(inner, depth, h0, youngs, poisson),
-              "wide": Block(np.concatenate([-outside[::-1], inner, outside]), depth, h0, youngs, poisson)}
+    wide = np.concatenate([-outside[::-1], inner, outside])
+    blocks = {"faces": Block(inner, depth, h0, youngs, poisson), "wide": Block(wide, depth, h0, youngs, poisson)}
+    if released:  # the wide block with a 20 µm layer just beyond each face that carries shear only
+        t = 0.02
+        nodes = np.sort(np.concatenate([wide, [-half - t, half + t]]))
+        blocks = {"faces": Block(nodes, depth, h0, youngs, poisson, release=(half, half + t), keep_shear=keep_shear),
+                  "wide": Block(nodes, depth, h0, youngs, poisson)}
     loads = {name: blk.loads(edges) for name, blk in blocks.items()}
     out = np.empty((ks.size, rows.size, rows.size))
     for m, k in enumerate(ks):
@@ -273,6 +293,17 @@ def main() -> int:
         _, steps, summ = run_mccoll(correction_matrix(d, ks[::2], grid.x, grid.dx), grid.shape)
         p0 = along_y(steps[0].pressure)
         say(f"   depth {depth:4.0f} mm: " + ", ".join(f"{SHORT[k]} {summ[k] / base[k] - 1:+.2%}" for k in SHORT)
+            + f"; end/centre pressure at N = 0 {p0[-1] / p0[ny // 2]:.3f}")
+
+    say()
+    say("5. The paper's approximation solved by FE: instead of free faces, a 20 µm layer just beyond each face that")
+    say("   carries shear but no normal stress (10 wavenumbers); compare scripts/prototype_paper_free_faces.py")
+    for keep, label in ((True, "shear kept (the approximation)"), (False, "nothing kept (check: = free faces)")):
+        d = face_correction(rows, grid.dy, youngs, poisson, ks[::2], split=4, h0=0.004, released=True,
+                            keep_shear=keep)
+        _, steps, summ = run_mccoll(correction_matrix(d, ks[::2], grid.x, grid.dx), grid.shape)
+        p0 = along_y(steps[0].pressure)
+        say(f"   {label:<36}" + ", ".join(f"{SHORT[k]} {summ[k] / base[k] - 1:+.2%}" for k in SHORT)
             + f"; end/centre pressure at N = 0 {p0[-1] / p0[ny // 2]:.3f}")
     (OUT / "free_faces_fe.txt").write_text("\n".join(lines) + "\n")
 
