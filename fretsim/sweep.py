@@ -178,9 +178,18 @@ _STOPPING = False  # a worker was told to stop: it starts no further point (some
 def _on_terminate(signum, frame) -> None:
     global _STOPPING
     _STOPPING = True
-    if _IN_POINT:
-        raise KeyboardInterrupt  # the run writes its file with status interrupted and releases its output
-    os._exit(0)  # idle: nothing to save
+    if not _IN_POINT:
+        os._exit(0)  # idle: nothing to save
+
+
+class _StopWhenTold:
+    """Ends a point's run at its next step once the worker was told to stop: the run then writes its file with
+    status interrupted.  Raised here, not in the signal handler: an exception raised by a handler can land in a
+    weakref callback or a __del__, where Python prints it and carries on (seen in CI)."""
+
+    def on_step(self, setup, step) -> None:
+        if _STOPPING:
+            raise KeyboardInterrupt
 
 
 def _init_worker() -> None:
@@ -200,10 +209,10 @@ def run_point(task: tuple) -> dict:
     try:
         _IN_POINT = True
         if mode == "resume":
-            outcome = resume(output)
+            outcome = resume(output, observers=(_StopWhenTold(),))
         else:
             case = parse_case(base_text, source=base_source, overrides=list(overrides))
-            outcome = run(case, output, overwrite=True)
+            outcome = run(case, output, overwrite=True, observers=(_StopWhenTold(),))
         return {"name": name, "status": outcome.status, "message": outcome.message, "summary": outcome.summary}
     except KeyboardInterrupt:
         return {"name": name, "status": "interrupted", "message": "the sweep was stopped; re-run it to resume"}
