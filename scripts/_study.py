@@ -8,6 +8,8 @@ for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
 
 import csv  # noqa: E402
 import dataclasses  # noqa: E402
+import importlib  # noqa: E402
+import sys  # noqa: E402
 import time  # noqa: E402
 from pathlib import Path  # noqa: E402
 
@@ -99,3 +101,27 @@ def pareto(points: list[tuple[float, float]]) -> list[int]:
                    if j != i and np.isfinite(e2)):
             idx.append(i)
     return idx
+
+
+class Report:
+    """Lines printed as they come and kept for the study's results file: ``say = Report(); say("…")``."""
+
+    def __init__(self):
+        self.lines: list[str] = []
+
+    def __call__(self, line: str = "") -> None:
+        print(line, flush=True)
+        self.lines.append(line)
+
+    def write(self, path: Path) -> None:
+        path.write_text("\n".join(self.lines) + "\n")
+
+
+def have_comparator(module: str, install: str) -> bool:
+    """Whether an optional comparator (never a dependency of fretsim) imports; if not, say how to get it."""
+    try:
+        importlib.import_module(module)
+        return True
+    except ImportError:
+        print(f"{module} is not installed ({install}): nothing to compare against", file=sys.stderr)
+        return False

@@ -24,19 +24,14 @@ under mesh refinement.
 """
 from __future__ import annotations
 
-import os
+import sys
+import time
 
-for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(var, "1")
-
-import sys  # noqa: E402
-import time  # noqa: E402
-from pathlib import Path  # noqa: E402
+from _study import ROOT, Report, have_comparator  # first: it pins the BLAS threads before numpy loads
 
 import numpy as np  # noqa: E402
 import scipy.sparse.linalg as spla  # noqa: E402
 
-ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "scripts" / "out"
 CASE = ROOT / "cases" / "mccoll_185N.yaml"
 DEPTH = 10.0  # mm, the flat's depth in the paper's FEA (section 2.1)
@@ -215,20 +210,13 @@ REPORTED = ("centre_wear_depth_stationary_um", "max_wear_depth_stationary_um", "
 
 
 def main() -> int:
-    try:
-        import skfem  # noqa: F401
-    except ImportError:
-        print("scikit-fem is not installed (pip install scikit-fem): nothing to compare against", file=sys.stderr)
+    if not have_comparator("skfem", "pip install scikit-fem"):
         return 1
     from fretsim.case import load_case
     from fretsim.plan import prepare
 
     OUT.mkdir(parents=True, exist_ok=True)
-    lines = []
-
-    def say(s=""):
-        print(s, flush=True)
-        lines.append(s)
+    say = Report()
 
     case = load_case(CASE)
     youngs, poisson = case.stationary.youngs_modulus, case.stationary.poissons_ratio
@@ -305,7 +293,7 @@ def main() -> int:
         p0 = along_y(steps[0].pressure)
         say(f"   {label:<36}" + ", ".join(f"{SHORT[k]} {summ[k] / base[k] - 1:+.2%}" for k in SHORT)
             + f"; end/centre pressure at N = 0 {p0[-1] / p0[ny // 2]:.3f}")
-    (OUT / "free_faces_fe.txt").write_text("\n".join(lines) + "\n")
+    say.write(OUT / "free_faces_fe.txt")
 
     import matplotlib
     matplotlib.use("Agg")

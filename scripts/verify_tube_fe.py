@@ -23,14 +23,10 @@ the radial layers halved with them).  The FE matrices are cached in scripts/out/
 """
 from __future__ import annotations
 
-import os
+import sys
+import time
 
-for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
-    os.environ.setdefault(var, "1")
-
-import sys  # noqa: E402
-import time  # noqa: E402
-from pathlib import Path  # noqa: E402
+from _study import ROOT, Report, have_comparator  # first: it pins the BLAS threads before numpy loads
 
 import numpy as np  # noqa: E402
 import scipy.sparse.linalg as spla  # noqa: E402
@@ -41,7 +37,6 @@ from fretsim.plan import prepare  # noqa: E402
 from fretsim.simulate import simulate  # noqa: E402
 from fretsim.wear import gap_wear  # noqa: E402
 
-ROOT = Path(__file__).resolve().parent.parent
 OUT = ROOT / "scripts" / "out"
 
 
@@ -191,17 +186,10 @@ def run(name: str, model: str, extra_grid: list[str], fe: np.ndarray | None):
 
 
 def main() -> int:
-    try:
-        import skfem  # noqa: F401
-    except ImportError:
-        print("scikit-fem is not installed (pip install scikit-fem): nothing to compare against", file=sys.stderr)
+    if not have_comparator("skfem", "pip install scikit-fem"):
         return 1
     OUT.mkdir(parents=True, exist_ok=True)
-    lines = []
-
-    def say(s=""):
-        print(s, flush=True)
-        lines.append(s)
+    say = Report()
 
     # one grid for both temperatures: the 90 °C case's (same element size, the wider scar's domain)
     setup90, _, _ = prepare(load_case(ROOT / "cases" / "tube_90C.yaml", ["model.dimension=2D"]))
@@ -286,7 +274,7 @@ def main() -> int:
                      ("fretsim: half-planes + ring bending", c_fretsim_bending)):
         d = pressure_difference(contact(c, gap_w, setup90.load, dx), ref_w)
         say(f"   {label:<38}{d['l2']:>9.2%}{d['peak']:>+9.2%}{d['width']:>+8.0f}")
-    (OUT / "verify_tube_fe.txt").write_text("\n".join(lines) + "\n")
+    say.write(OUT / "verify_tube_fe.txt")
 
     import matplotlib
     matplotlib.use("Agg")
