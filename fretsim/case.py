@@ -28,7 +28,7 @@ SCHEMES = ("bdf2", "implicit", "linear", "adaptive")
 PRESETS = {"paper": {"scheme": "adaptive", "eta": 0.55, "max": 600, "linear": 55}}
 DIMENSIONS = ("2d", "3d", "auto")
 GAP_MODELS = ("auto", "mid_stroke", "stroke_average")
-CORRECTIONS = ("ring_bending",)
+CORRECTIONS = ("ring_bending", "free_faces")
 MAX_CYCLES = 10**10
 LENGTH_RANGE = (1e-3, 1e4, "1 µm to 10 m")
 REQUIRED = object()
@@ -58,7 +58,10 @@ GEOMETRY_KEYS: dict[str, dict[str, Key]] = {
     "cylinder_on_flat": {
         "radius": Key("length", "cylinder radius R (Eq. 9)", REQUIRED, plausible=LENGTH_RANGE, example="6 mm"),
         "length": Key("length", "cylinder length L along y (the line contact's length)", REQUIRED,
-                      plausible=LENGTH_RANGE, example="10 mm")},
+                      plausible=LENGTH_RANGE, example="10 mm"),
+        "block_length": Key("length", "the flat's length along y when it ends in free faces, centred on the "
+                                      "cylinder (McColl's flat: as long as the cylinder; at least L); omitted: the "
+                                      "flat runs on well beyond the contact", None, plausible=LENGTH_RANGE)},
     "ball_on_flat": {
         "radius": Key("length", "ball radius R (Eq. 10)", REQUIRED, plausible=LENGTH_RANGE, example="6 mm")},
     "crossed_cylinders": {
@@ -83,6 +86,9 @@ GEOMETRY_KEYS: dict[str, dict[str, Key]] = {
         "edge_radius": Key("length", "edge rounding: beyond flat_length/2 the profile drops by (|y| − l/2)²/2r_e",
                            None, plausible=LENGTH_RANGE),
         "flat_length": Key("length", "the straight middle of an edge-rounded roller", None, plausible=LENGTH_RANGE),
+        "block_length": Key("length", "the flat's length along y when it ends in free faces, centred on the "
+                                      "roller (at least L); omitted: the flat runs on well beyond the contact", None,
+                            plausible=LENGTH_RANGE),
         "profile": Key("text", "a CSV of the axial profile drop: a header `y [unit], drop [unit]`, then rows "
                                "(relative to the case file; mirrored if given for y ≥ 0 only)", None),
         "profile_table": Key("table", "the same profile inline: {y: [lengths], drop: [lengths]} (the filled case "
@@ -115,7 +121,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
                              "(stable for any wear coefficients) or auto", "auto", choices=GAP_MODELS),
         "corrections": Key("corrections", "compliance added to the half-spaces: `auto` (each where its effect "
                                           "exceeds model.accuracy), `none`, or a list of ring_bending "
-                                          "(tubes, Eq. 23)", "auto"),
+                                          "(tubes, Eq. 23) and free_faces (3d: bodies that end across the "
+                                          "contact, paper §2.1)", "auto"),
         "accuracy": Key("fraction", "largest difference from the full model accepted when `auto` simplifies it",
                         0.01, lo=1e-4, hi=0.5)},
     "solver": {
@@ -559,8 +566,14 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
                 r.fail(f"geometry.{k}", f"a {gtype} has no {k}; its keys are {', '.join(keys)}")
         vals = {k: r.key(geo, k, spec, f"geometry.{k}") for k, spec in keys.items()}
         if all(v is not None for k, v in vals.items() if keys[k].default is REQUIRED):
-            if gtype == "cylinder_on_flat":
-                geometry = CylinderOnFlat(vals["radius"], vals["length"])
+            if vals.get("block_length") is not None and vals["block_length"] < vals["length"] * (1 - 1e-9):
+                r.fail("geometry.block_length", f"the flat ({format_quantity(vals['block_length'], 'length')}) is "
+                                                f"shorter than the {gtype.split('_')[0]} "
+                                                f"({format_quantity(vals['length'], 'length')}): its edges would "
+                                                f"cut into the contact, which fretsim does not model; expected at "
+                                                f"least geometry.length")
+            elif gtype == "cylinder_on_flat":
+                geometry = CylinderOnFlat(vals["radius"], vals["length"], vals["block_length"])
             elif gtype == "ball_on_flat":
                 geometry = BallOnFlat(vals["radius"])
             elif gtype == "crossed_cylinders" and vals["sliding"] is not None:
@@ -575,8 +588,8 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
                 elif vals["edge_radius"] and vals["flat_length"] is None:
                     r.fail("geometry.flat_length", "an edge-rounded roller needs the length of its straight middle")
                 elif table[0] is not None or not vals.get("profile"):
-                    geometry = RollerOnFlat(vals["radius"], vals["length"], vals["crown_radius"],
-                                            vals["edge_radius"], vals["flat_length"], *table)
+                    geometry = RollerOnFlat(vals["radius"], vals["length"], vals["block_length"],
+                                            vals["crown_radius"], vals["edge_radius"], vals["flat_length"], *table)
             elif gtype == "tube_on_flat":
                 if vals["inner_radius"] >= vals["outer_radius"]:
                     r.fail("geometry.inner_radius", "must be smaller than geometry.outer_radius")

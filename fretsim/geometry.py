@@ -11,7 +11,9 @@ Every geometry knows
 * ``limits`` — where the geometry stops describing the body (worn through, the paraboloid of Eqs. 9–10 no
   longer the circle);
 * ``extra_compliance(grid, moving)`` — an operator to add to the half-space's (the tube's ring bending),
-  or None.
+  or None;
+* ``free_faces`` — the bodies that end in free faces across the contact (y = ±length/2), as (body, length)
+  pairs: a cylinder's own ends, and the flat's when the case gives its length (paper §2.1, Fig. 2).
 
 x is the sliding direction, y across it; the moving body is the one that slides.  All lengths in mm.
 """
@@ -76,6 +78,10 @@ class Geometry:
     def extra_compliance(self, grid: Grid, youngs_modulus: float, poissons_ratio: float):
         return None
 
+    @property
+    def free_faces(self) -> tuple[tuple[str, float], ...]:
+        return ()
+
     def scar_half_widths(self, volume: float) -> tuple[float, float]:
         """Half-widths (mm) along x and y of a scar holding the worn ``volume`` (mm³) of both bodies (sizing).
 
@@ -107,10 +113,15 @@ class CylinderOnFlat(Geometry):
     kind: ClassVar[str] = "cylinder_on_flat"
     radius: float
     length: float
+    block_length: Optional[float] = None  # the flat's length along y when it ends in free faces (mm)
 
     @property
     def line_length(self) -> float:
         return self.length
+
+    @property
+    def free_faces(self) -> tuple[tuple[str, float], ...]:
+        return (("moving", self.length),) + ((("stationary", self.block_length),) if self.block_length else ())
 
     def separation(self, grid: Grid) -> np.ndarray:
         return _line_gap(grid, self.radius, self.length)
@@ -223,6 +234,10 @@ class TubeOnFlat(Geometry):
 
     def scar_half_widths(self, volume: float) -> tuple[float, float]:
         return (1.5 * self.outer_radius * volume / self.length) ** (1 / 3), self.length / 2
+
+    @property
+    def free_faces(self) -> tuple[tuple[str, float], ...]:
+        return (("stationary", self.length),)  # the support (a flat bar) is as long as the contact; the tube goes on
 
     def extra_compliance(self, grid: Grid, youngs_modulus: float, poissons_ratio: float):
         from fretsim.compliance.ring import RingBending
