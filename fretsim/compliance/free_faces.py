@@ -1,10 +1,11 @@
 """Free faces of a body that ends across the contact: the compliance they add to the half-space's (paper §2.1).
 
 A cylinder pressed on a flat block as long as itself (McColl's test, the paper's Fig. 2) loads the block right
-up to its faces at y = ±B/2, where a half-space would have material beyond; so are the cylinder's own ends.  The
-faces carry no traction, so the body is softer there and its ends carry less of the load.  The paper approximates this with overlapping half-spaces (the
-shear on the overlaps neglected); solved exactly, that approximation captures about a fifth of the faces'
-effect (scripts/study_free_faces_fe.py), so fretsim solves the block itself instead.
+up to its faces at y = ±B/2, where a half-space would have material beyond; so are the cylinder's own ends.
+The faces carry no traction, so the body is softer there and its ends carry less of the load.  The paper
+approximates this with overlapping half-spaces (the shear on the overlaps neglected); solved exactly, that
+approximation captures about a fifth of the faces' effect (scripts/study_free_faces_fe.py), so fretsim solves
+the block itself instead.
 
 The block is prismatic: infinite along x (sliding), its cross-section B wide and D deep (bottom fixed).  A
 surface pressure q(y)·cos(kx) gives displacements (U sin kx, V cos kx, W cos kx) with U, V, W functions of
