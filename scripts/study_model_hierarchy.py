@@ -4,8 +4,9 @@ Fidelities: 2D line contact (where the geometry has one), 3D half-spaces, 3D + t
 (Eq. 23; tubes only), 3D + the free faces of bodies that end across the contact (paper §2.1: the cylinder's or
 roller's ends, the flat's where the case gives geometry.block_length, a tube's support).  For each, the wall
 time of the loop and the difference of the reported quantities (maximum depth of each body, the flat's
-centre-line depth, the scar width of each body) from the fullest model, and what `model.dimension: auto` / `model.corrections: auto` choose for the scene (set to auto here even where
-the shipped case fixes its model), with the reason.
+centre-line depth, the scar width of each body) from the fullest model, and what `model.dimension: auto` /
+`model.corrections: auto` choose for the scene (set to auto here even where the shipped case fixes its model),
+with the reason.
 
     python scripts/study_model_hierarchy.py [--quick] [--out scripts/out]
 
