@@ -304,6 +304,8 @@ def _delta(rows_y: np.ndarray, dy: float, length: float, youngs: float, poisson:
     share it)."""
     key = (tuple(np.round(rows_y, 12)), round(dy, 12), round(length, 12), youngs, poisson)
     if key not in _CACHE:
+        if len(_CACHE) >= 8:  # a sweep over lengths or grids would otherwise keep every one
+            _CACHE.pop(next(iter(_CACHE)))
         ks = np.asarray(K_SAMPLES) / length
         _CACHE[key] = ks, face_settlement(rows_y, dy, length, youngs, poisson, ks)
     return _CACHE[key]
