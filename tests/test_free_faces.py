@@ -44,7 +44,8 @@ def test_the_face_correction_matches_an_independent_finite_element_solution():
 
 
 def test_faces_far_from_the_contact_change_nothing():
-    # the operator (integrated over k) at the centre element: faces 2 mm beyond the last row against 18 mm
+    # the operator (integrated over k): faces at the grid's ends, on the end element, against a flat 40 mm long
+    # (faces 17.75 mm beyond the grid), on the centre element
     grid = Grid.centred(21, 9, 0.02, 0.5)
     near = free_faces(grid, [(4.5, 200e3, 0.3)]).kernel
     far = free_faces(grid, [(40.0, 200e3, 0.3)]).kernel
