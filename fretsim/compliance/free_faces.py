@@ -27,6 +27,7 @@ import numpy as np
 import scipy.fft as sfft
 import scipy.linalg as sla
 
+from fretsim.compliance import fft
 from fretsim.compliance.operator import _check_dense, window_grid
 from fretsim.grid import Grid
 
@@ -236,13 +237,13 @@ class RowConvolution:
     def __call__(self, p: np.ndarray) -> np.ndarray:
         nx = self.grid.shape[1]
         q = p if self.basis is None else self.basis.T @ p
-        ph = np.ascontiguousarray(sfft.rfft(q, n=self.n_fft, axis=1).T)  # (modes, r) complex
+        ph = np.ascontiguousarray(fft.forward(q, (1, self.n_fft)).T)  # (modes, r) complex
         if self.real:  # real symbol times complex data: as two real columns
             uh = np.matmul(self.hat, ph.view(np.float64).reshape(*ph.shape, 2)).reshape(ph.shape[0], -1)
             uh = uh.view(np.complex128)
         else:
             uh = np.matmul(self.hat, ph[:, :, None])[:, :, 0]
-        u = sfft.irfft(uh.T, n=self.n_fft, axis=1)[:, :nx]
+        u = fft.backward(np.ascontiguousarray(uh.T), (1, self.n_fft), (uh.shape[1], nx))
         return u if self.basis is None else self.basis @ u
 
     def full_kernel(self) -> np.ndarray:
