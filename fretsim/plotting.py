@@ -34,15 +34,30 @@ def _input(res: Results, key: str, default=None):
     return res.inputs.get(key, (default, ""))[0]
 
 
+def _float(res: Results, key: str) -> float | None:
+    """An input as a finite number, or None where the file lacks it or holds something else: a damaged or
+    foreign file still plots its data, without what it could not read (a "?" in the title, no reference line)."""
+    try:
+        value = float(_input(res, key))
+    except (TypeError, ValueError):
+        return None
+    return value if np.isfinite(value) else None
+
+
+def _number(res: Results, key: str, spec: str) -> str:
+    value = _float(res, key)
+    return "?" if value is None else format(value, spec)
+
+
 def title_block(res: Results) -> str:
     """Case, load, stroke, wear coefficients, model and the --set overrides, for every figure."""
     name = res.attrs.get("case_name", "")
     status = "" if res.status == "complete" else f" [{res.status}]"
     parts = [f"{name}{status}"]
     if res.inputs:
-        parts.append(f"P = {_input(res, 'normal_load'):.4g} N, δ = ±{_input(res, 'stroke'):.4g} µm, "
-                     f"N = {_input(res, 'cycles')}, k_m = {_input(res, 'moving_wear_coefficient'):.3g}, "
-                     f"k_s = {_input(res, 'stationary_wear_coefficient'):.3g} 1/MPa; "
+        parts.append(f"P = {_number(res, 'normal_load', '.4g')} N, δ = ±{_number(res, 'stroke', '.4g')} µm, "
+                     f"N = {_number(res, 'cycles', '.0f')}, k_m = {_number(res, 'moving_wear_coefficient', '.3g')}, "
+                     f"k_s = {_number(res, 'stationary_wear_coefficient', '.3g')} 1/MPa; "
                      f"{str(_input(res, 'dimension', '')).upper()} {_input(res, 'geometry', '')}, gap "
                      f"{_input(res, 'gap_model', '')}, {_input(res, 'scheme', '')}")
     if res.overrides:
@@ -174,9 +189,9 @@ def _profiles(res: Results):
 
 def hertz_profile(res: Results, x: np.ndarray) -> np.ndarray | None:
     """The initial Hertz pressure along x (y = 0), from the inputs recorded in the file."""
-    a = _input(res, "hertz_half_width_x")
-    p0 = _input(res, "hertz_peak_pressure")
-    if a is None or p0 is None:
+    a = _float(res, "hertz_half_width_x")
+    p0 = _float(res, "hertz_peak_pressure")
+    if a is None or p0 is None or a <= 0:
         return None
     return p0 * np.sqrt(np.clip(1.0 - (x / a) ** 2, 0.0, None))
 
@@ -267,9 +282,9 @@ def _history(res: Results, log_cycles: bool):
                                        ("wear_volume_stationary", "stationary", "stationary_wear_coefficient")),
                                       STYLES):
         line, = ax.plot(n, h[name], ls=ls, marker="o", ms=2.5, lw=1.3, label=label)
-        k = _input(res, key)
-        if k is not None:
-            archard = k * _input(res, "normal_load") * 4 * _input(res, "stroke") * 1e-3 * n
+        k, load, stroke = _float(res, key), _float(res, "normal_load"), _float(res, "stroke")
+        if None not in (k, load, stroke):
+            archard = k * load * 4 * stroke * 1e-3 * n
             ax.plot(n, archard, color=line.get_color(), lw=0.8, alpha=0.6, ls=(0, (1, 2)),
                     label=f"Archard k·P·4δ·N, {label}")
     ax.set_ylabel(f"wear volume ({_unit(res, 'history/wear_volume_moving')})")

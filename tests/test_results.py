@@ -158,6 +158,21 @@ def test_a_disk_that_fills_while_plotting_leaves_earlier_figures_whole_and_no_te
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
+def test_a_file_with_damaged_inputs_still_plots_its_data_and_says_what_it_could_not_read(results_3d, tmp_path):
+    # found by the slow fuzz (a flipped bit in an /inputs name): plot must not fail on metadata it only titles with
+    from fretsim.plotting import title_block
+    path = tmp_path / "d.h5"
+    path.write_bytes(Path(results_3d).read_bytes())
+    with h5py.File(path, "r+") as f:
+        del f["inputs/stroke"]
+        del f["inputs/normal_load"]
+        f["inputs/hertz_peak_pressure"][()] = np.nan
+    r = CliRunner().invoke(main, ["plot", str(path), "-o", str(tmp_path / "figs"), "--jobs", "1"])
+    assert r.exit_code == 0, r.output
+    assert len(list((tmp_path / "figs").glob("*.png"))) >= 4
+    assert "P = ? N, δ = ±? µm" in title_block(read_results(path))
+
+
 def test_plot_writes_the_format_asked_for(results_3d, tmp_path):
     r = CliRunner().invoke(main, ["plot", str(results_3d), "-o", str(tmp_path), "--format", "svg", "--dpi", "100",
                                   "--log"])
