@@ -103,6 +103,19 @@ def choose_dimension(case: Case, e_star: float) -> Choice:
 PROXY_ROWS = 15
 
 
+def _full_corrections(case: Case, dimension: str):
+    """The corrections of the full model a dimension proxy runs: the case's own, less the free faces in 2D (which
+    has no ends); in 3D with the free faces wherever they may apply (and, under auto, a tube's ring bending)."""
+    corr, g = case.corrections, case.geometry
+    given = () if corr in ("auto", "none") else tuple(corr)
+    if dimension == "2d":
+        return corr if not given else (tuple(c for c in given if c != "free_faces") or "none")
+    if not g.free_faces or not (corr == "auto" or "free_faces" in given):
+        return corr
+    bending = ("ring_bending",) if isinstance(g, TubeOnFlat) and corr == "auto" else ()
+    return tuple(dict.fromkeys(given + ("free_faces",) + bending))
+
+
 def _dimension_proxy(case: Case, e_star: float) -> tuple[float, str]:
     from fretsim.simulate import simulate, summarize
     g = case.geometry
@@ -112,17 +125,8 @@ def _dimension_proxy(case: Case, e_star: float) -> tuple[float, str]:
     keys = (("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "centre_wear_depth_stationary_um",
              "scar_width_moving_mm", "scar_width_stationary_mm") if case.cycles else ("max_pressure_MPa",))
     out = []
-    # the full model: with the free faces wherever they may apply
-    faces = g.free_faces and (case.corrections == "auto"
-                              or (case.corrections != "none" and "free_faces" in tuple(case.corrections)))
     for dim, domain, elements in (("2d", sizing.domain[:1], (nx,)), ("3d", sizing.domain, (nx, PROXY_ROWS))):
-        corr = case.corrections
-        if dim == "2d" and corr not in ("auto", "none"):
-            corr = tuple(c for c in corr if c != "free_faces") or "none"
-        elif dim == "3d" and faces:  # the full model: with the free faces
-            corr = tuple(c for c in ((corr,) if isinstance(corr, str) else corr) if c not in ("auto", "none"))
-            corr = tuple(dict.fromkeys(corr + ("free_faces",) + (("ring_bending",) if isinstance(g, TubeOnFlat)
-                                                                  and case.corrections == "auto" else ())))
+        corr = _full_corrections(case, dim)
         proxy = case.with_choices(dimension=dim, corrections=corr, snapshots=(case.cycles,), domain=domain,
                                   elements=elements,
                                   coarse_element=None, linear_jump=None, scheme="bdf2", preset=None,
