@@ -120,6 +120,7 @@ class _Progress:
         if self.off or not setup.cycles:
             return
         import time
+        from fretsim.plan import estimate_solves
         self.solves_expected = max(1, estimate_solves(setup))
         self.solves = 0
         self.t0 = time.perf_counter()
@@ -147,20 +148,6 @@ class _Progress:
         if self.bar is not None:
             self.bar.__exit__(None, None, None)
             self.bar = None
-
-
-def estimate_solves(setup) -> int:
-    """Solves a run is expected to take (measured on the shipped cases; for progress and `check`)."""
-    import math
-    n = setup.cycles
-    if n == 0:
-        return 1
-    if setup.scheme in ("bdf2", "implicit"):
-        # ~25 solves per decade of cycles after the first, ~7 per recorded state landed on (measured)
-        return min(n + 1, int(10 + 12 * math.log10(max(n, 10)) + 7 * len(setup.snapshots)))
-    if setup.scheme == "linear":
-        return n // setup.linear_jump + len(setup.snapshots) + 1
-    return int(n / (setup.linear_jump * 6 + 300)) * 6 + len(setup.snapshots) + 10
 
 
 def _paragraph(outcome) -> str:
@@ -208,7 +195,8 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
     cells = f"{g.shape[1]} elements of {g.dx * 1e3:.4g} µm" if g.plane_strain else \
         f"{g.shape[1]} × {g.shape[0]} elements of {g.dx * 1e3:.4g} × {g.dy * 1e3:.4g} µm"
     click.echo(f"{filled.name}: {filled.cycles} cycles, {filled.dimension.upper()} {filled.geometry.kind}, {cells}")
-    click.echo(f"explicit stability limit: {setup.stability_limit:.4g} cycles (solve grid, gap model {setup.gap_model})")
+    click.echo(f"explicit stability limit: {setup.stability_limit:.4g} cycles (solve grid, gap model {filled.gap_model})")
+    from fretsim.plan import estimate_cost
     solves, seconds = estimate_cost(setup)
     click.echo(f"estimate: about {solves} contact solves, {seconds:.2g} s")
     click.echo("choices:")
@@ -219,20 +207,6 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
         click.echo(f"warning: {w}")
     click.echo("filled case:")
     click.echo("  " + filled.to_yaml().rstrip().replace("\n", "\n  "))
-
-
-def estimate_cost(setup) -> tuple[int, float]:
-    """(solves, seconds) before a run: solves from the scheme, seconds from one timed contact solve."""
-    import time
-
-    from fretsim.solvers import solve
-    solves = estimate_solves(setup)
-    op = setup.coarse_compliance or setup.compliance
-    gap = setup.coarse_gap if setup.coarse_gap is not None else setup.gap
-    t = time.perf_counter()
-    solve(op, gap, setup.load, method=setup.method, tol=setup.tolerance)
-    cold = time.perf_counter() - t
-    return solves, solves * cold * 0.5  # a warm-started solve on a window takes about half a cold one (measured)
 
 
 def _show(value) -> str:

@@ -10,8 +10,8 @@ Every geometry knows
   None for a point contact, which has no 2D model;
 * ``limits`` — where the geometry stops describing the body (worn through, the paraboloid of Eqs. 9–10 no
   longer the circle);
-* ``extra_compliance(grid, moving)`` — an operator to add to the half-space's (the tube's ring bending),
-  or None;
+* ``body_corrections`` and ``extra_compliance(grid, E, ν)`` — the corrections the moving body's own shape adds
+  to the half-space's compliance (the tube's ring bending), and the operator of them;
 * ``free_faces`` — the bodies that end in free faces across the contact (y = ±length/2), as (body, length)
   pairs: a cylinder's own ends, and the flat's when the case gives its length (paper §2.1, Fig. 2).
 
@@ -74,6 +74,8 @@ class Geometry:
     def y_edges_free(self) -> bool:
         """True when the contact may end at the grid's y edges (the ends of a line contact)."""
         return self.line_length is not None
+
+    body_corrections: ClassVar[tuple[str, ...]] = ()  # compliance corrections of the body's own shape
 
     def extra_compliance(self, grid: Grid, youngs_modulus: float, poissons_ratio: float):
         return None
@@ -208,6 +210,7 @@ class TubeOnFlat(Geometry):
     at the wall thickness."""
 
     kind: ClassVar[str] = "tube_on_flat"
+    body_corrections: ClassVar[tuple[str, ...]] = ("ring_bending",)
     outer_radius: float
     inner_radius: float
     length: float

@@ -15,9 +15,10 @@ from typing import Any, Optional
 import numpy as np
 
 from fretsim.case import PRESETS, Case, CaseError
-from fretsim.compliance import HalfSpace, Sum, add
-from fretsim.geometry import TubeOnFlat
+from fretsim.compliance import HalfSpace, add
+from fretsim.cycle import UniformCycle
 from fretsim.grid import Grid
+from fretsim.loading import Loading, single
 from fretsim.reference import effective_modulus
 from fretsim.simulate import Setup, SimulationError
 from fretsim.sizing import Sizing, auto_grid
@@ -112,7 +113,7 @@ def _full_corrections(case: Case, dimension: str):
         return corr if not given else (tuple(c for c in given if c != "free_faces") or "none")
     if not g.free_faces or not (corr == "auto" or "free_faces" in given):
         return corr
-    bending = ("ring_bending",) if isinstance(g, TubeOnFlat) and corr == "auto" else ()
+    bending = g.body_corrections if corr == "auto" else ()
     return tuple(dict.fromkeys(given + ("free_faces",) + bending))
 
 
@@ -183,8 +184,7 @@ FACES_NOTE = ("the free faces of {what} (paper §2.1; solved as a finite block, 
 
 def available_corrections(case: Case, plane: bool) -> tuple[str, ...]:
     g = case.geometry
-    out = ("ring_bending",) if isinstance(g, TubeOnFlat) else ()
-    return out + (("free_faces",) if g.free_faces and not plane else ())
+    return g.body_corrections + (("free_faces",) if g.free_faces and not plane else ())
 
 
 def _faces_what(case: Case) -> str:
@@ -317,6 +317,33 @@ def choose_snapshots(case: Case) -> Choice:
                   "automatic: 0, N/4, N/2, 3N/4 and N")
 
 
+def estimate_solves(setup) -> int:
+    """Solves a run is expected to take (measured on the shipped cases; for progress and `check`)."""
+    n = setup.cycles
+    if n == 0:
+        return 1
+    if setup.scheme in ("bdf2", "implicit"):
+        # ~25 solves per decade of cycles after the first, ~7 per recorded state landed on (measured)
+        return min(n + 1, int(10 + 12 * math.log10(max(n, 10)) + 7 * len(setup.snapshots)))
+    if setup.scheme == "linear":
+        return n // setup.linear_jump + len(setup.snapshots) + 1
+    return int(n / (setup.linear_jump * 6 + 300)) * 6 + len(setup.snapshots) + 10
+
+
+def estimate_cost(setup) -> tuple[int, float]:
+    """(solves, seconds) before a run: solves from the scheme, seconds from one timed contact solve."""
+    import time
+
+    from fretsim.solvers import solve
+    solves = estimate_solves(setup)
+    op = setup.coarse_compliance or setup.compliance
+    gap = setup.coarse_gap if setup.coarse_gap is not None else setup.gap
+    t = time.perf_counter()
+    solve(op, gap, setup.cycle.load, method=setup.method, tol=setup.tolerance)
+    cold = time.perf_counter() - t
+    return solves, solves * cold * 0.5  # a warm-started solve on a window takes about half a cold one (measured)
+
+
 # --- prepare ----------------------------------------------------------------------------------------------------
 
 def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan]:
@@ -362,8 +389,8 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
         cny = 1 if plane else max(1, int(round(domain[1] / case.coarse_element[1])))
         coarse_n = cnx * cny
     need = memory_estimate(nx * ny, len(snapshots) + 5, case.solver, coarse_n)
-    if isinstance(g, TubeOnFlat) and case.corrections != "none":
-        need += 8.0 * nx * nx  # the ring-bending matrix along x
+    if g.body_corrections and case.corrections != "none":
+        need += 8.0 * nx * nx  # a body's own compliance (the tube's ring bending): a dense matrix along x
     if g.free_faces and not plane and case.corrections != "none":
         need += 8.0 * ny * ny * (2 * nx) * 3  # the free faces' kernel between every pair of rows, and its symbol
     if need > MEMORY_SHARE * available_memory():
@@ -452,14 +479,18 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
         plan.warnings.append(f"snapshots {list(beyond)} lie beyond the run's {case.cycles} cycles and are skipped")
     snapshots = tuple(sorted({s for s in snapshots if s <= case.cycles} | {case.cycles}))
     warn_gross_slip(case, e_star, hertz, plan)
+    loading = loading_of(case)
     load = case.normal_load / g.line_length if plane else case.normal_load
-    setup = Setup(grid=grid, compliance=compliance, gap=g.separation(grid), load=load, total_load=case.normal_load,
-                  k_moving=k_m, k_stationary=k_s, stroke=case.stroke, cycles=case.cycles, gap_model=gap_model,
+    model = UniformCycle(grid=grid, wear_op=wear_operator(solve_op.grid, case.stroke, k_m, k_s, gap_model),
+                         stroke=case.stroke, load=load, total_load=case.normal_load, k_moving=k_m, k_stationary=k_s,
+                         gap_model=gap_model, friction_coefficient=case.friction_coefficient)
+    reach = stroke_reach(grid.dx, case.stroke)
+    band = (2 * reach if gap_model == "stroke_average" else reach) + 1  # the flat's wear, as the solve sees it
+    setup = Setup(grid=grid, compliance=compliance, gap=g.separation(grid), loading=loading, cycle=model, band=band,
                   scheme=scheme, linear_jump=jump, stability_limit=limit, method=case.solver,
                   tolerance=case.tolerance, snapshots=snapshots,
                   volume_factor=g.line_length if plane else 1.0, limits=g.limits, y_edges_free=g.y_edges_free,
-                  eta=case.eta, max_jump=max_jump, step_tolerance=case.step_tolerance, implicit_cap=cap,
-                  wear_op=wear_operator(solve_op.grid, case.stroke, k_m, k_s, gap_model), coarse=coarse,
+                  eta=case.eta, max_jump=max_jump, step_tolerance=case.step_tolerance, implicit_cap=cap, coarse=coarse,
                   coarse_compliance=coarse_op, coarse_gap=coarse_gap, per_cycle=per_cycle,
                   notes=tuple(f"{c.key} = {_show(c.value)}: {c.reason}" for c in plan.choices if not c.given)
                   + tuple(plan.warnings))
@@ -468,6 +499,11 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
                                elements=(nx,) if plane else (nx, ny), gap_model=gap_model, scheme=scheme,
                                linear_jump=jump, max_jump=max_jump, snapshots=snapshots)
     return setup, filled, plan
+
+
+def loading_of(case: Case) -> Loading:
+    """The case's loading: one block today."""
+    return single(case.normal_load, case.stroke, case.cycles, case.friction_coefficient)
 
 
 def _check_model_growth(case: Case, gap_model: str, spectrum: Spectrum, plan: Plan) -> None:

@@ -1,10 +1,11 @@
 """The contact–wear loop (paper Fig. 8, Eqs. 15–18).  Knows nothing of files or plots: observers get each step.
 
-Per step: the pressure p for the current gap → the flat's stroke-averaged
-pressure → Archard increments of both bodies → the next gap.  Each recorded
-step holds the wear at its cycle and the pressure that wear produces, so
-histories and snapshots are consistent.  The loop takes a :class:`Setup` —
-arrays, numbers and operators, built from a case by :func:`fretsim.plan.prepare`.
+Per step: one representative fretting cycle at the current wear (a member of :mod:`fretsim.cycle`: the
+pressure, each body's slip and wear per cycle) → the stepping scheme advances the wear → the next cycle.  The
+loop never looks inside the cycle: it steps the wear with the rates the cycle returns and checks the member's
+invariant.  Each recorded step holds the wear at its cycle and the cycle that wear produces, so histories and
+snapshots are consistent.  The loop takes a :class:`Setup` — arrays, numbers, operators, the loading and the
+cycle model, built from a case by :func:`fretsim.plan.prepare`.
 """
 from __future__ import annotations
 
@@ -14,17 +15,18 @@ from typing import Callable, Optional, Protocol
 
 import numpy as np
 
-from fretsim.compliance import Convolution, add, scaled
+from fretsim.compliance import add
+from fretsim.cycle import Cycle
 from fretsim.geometry import Limits
 from fretsim.grid import Grid
 from fretsim.jumping import (OMEGA_MAX, Q_LINEAR, THETA_LANDING, bdf2_coefficients, bdf2_local_error, next_step,
                              taylor_extrapolate, taylor_jump)
+from fretsim.loading import Loading
 from fretsim.refine import coarsen, refine_pressure
 from fretsim.solvers import solve
 from fretsim.stability import NOISE_FLOOR, GrowthWatch, checkerboard_signed
-from fretsim.wear import archard_volume, gap_wear, stroke_average, stroke_reach, wear_rates
 
-ARCHARD_ROUND_OFF = 1e-9  # the volume is k·P·4δ·N by construction; anything larger is a bug
+ARCHARD_ROUND_OFF = 1e-9  # the volume is the invariant's (k·P·4δ·N, k·Σp|ds|A) by construction; more is a bug
 LOAD_BALANCE = 1e-8  # every solver enforces Σp·A = P exactly; a larger error is a solver fault
 MAX_RETRIES = 8  # a failed solve is retried with a smaller step this many times (implicit, adaptive)
 HISTORY_POINTS = 8  # states kept for BDF2 (partner, error estimate) and the predictor
@@ -73,13 +75,9 @@ class Setup:
     grid: Grid
     compliance: object  # the influence operator on ``grid`` (fretsim.compliance)
     gap: np.ndarray  # initial separation ε (mm), +inf where no contact is possible
-    load: float  # on the grid: N (3D) or N/mm (2D)
-    total_load: float  # N
-    k_moving: float
-    k_stationary: float
-    stroke: float
-    cycles: int
-    gap_model: str  # mid_stroke | stroke_average (fretsim.wear)
+    loading: Loading
+    cycle: object  # the fretting-cycle model (fretsim.cycle): what one cycle does at a wear state
+    band: int  # elements from the x edges the pressure must keep clear of (the flat's wear reaches that far)
     scheme: str  # bdf2 | implicit | linear | adaptive
     linear_jump: int
     stability_limit: float
@@ -93,7 +91,6 @@ class Setup:
     max_jump: Optional[int] = None
     step_tolerance: float = 1e-2
     implicit_cap: float = float("inf")  # largest s keeping C + s·W positive definite
-    wear_op: Optional[Convolution] = None  # W on the solve grid
     coarse: Optional[Grid] = None  # refinement: contact solved here, pressure refined to ``grid``
     coarse_compliance: object = None
     coarse_gap: Optional[np.ndarray] = None
@@ -105,6 +102,10 @@ class Setup:
     def solve_grid(self) -> Grid:
         return self.coarse if self.coarse is not None else self.grid
 
+    @property
+    def cycles(self) -> int:
+        return self.loading.cycles
+
 
 @dataclass
 class Step:
@@ -113,6 +114,7 @@ class Step:
     wear_stationary: np.ndarray  # mm
     pressure: np.ndarray  # MPa, on the moving body at mid-stroke
     pressure_average: np.ndarray  # MPa, stroke-averaged, on the stationary body
+    cycle_result: Cycle  # the representative cycle at this state: slips, shear, energy, loop
     iterations: int
     wall_time: float  # s since the start of the run
     approach: float
@@ -125,6 +127,7 @@ class Step:
     checkerboard: float = 0.0  # signed odd-even pressure amplitude / mean pressure
     error_depth: float = 0.0  # the run's estimate of the relative depth error (accumulated)
     error_pressure: float = 0.0  # the run's estimate of the relative pressure error (L2) of this state
+    work: float = 0.0  # the member's invariant accumulated to this cycle (volume = k·work), N·mm
     state: dict = field(default_factory=dict)  # the loop's checkpoint after this step (for resuming)
 
 
@@ -148,43 +151,53 @@ def _rel(v: np.ndarray, ref: np.ndarray) -> float:
 
 
 class _Loop:
-    """The loop's only mutable state: wear of both bodies, pressure, cycle, and the stepping scheme's memory.
+    """The loop's only mutable state: wear of both bodies, the current cycle's pressure and rates, cycle, and the
+    stepping scheme's memory.
 
-    All of it is in the attributes listed in ``STATE``, which every emitted step carries as a checkpoint.
+    All of it is in the attributes listed in ``STATE``, which every emitted step carries as a checkpoint.  Besides
+    the wear, the loop carries ``work``: the member's invariant (volume = k·work) advanced by the same formulas as
+    the wear, so a broken spatial update shows as a volume off its invariant.
     """
 
-    STATE = ("n", "h_m", "h_s", "p", "jump", "rejected", "elapsed", "lag", "err_abs_m", "err_abs_s", "p_prev",
-             "d_prev")
+    STATE = ("n", "h_m", "h_s", "p", "r_m", "r_s", "rate_work", "work", "jump", "rejected", "elapsed", "lag", "err_abs_m",
+             "err_abs_s", "p_prev", "d_prev")
 
     def __init__(self, setup: Setup, observers, progress):
         self.s = setup
+        self.model = setup.cycle
         self.observers = observers
         self.progress = progress
         self.t0 = time.perf_counter()
-        reach = stroke_reach(setup.grid.dx, setup.stroke)
-        self.band = (2 * reach if setup.gap_model == "stroke_average" else reach) + 1
         self.stops = sorted(set(setup.snapshots) | {setup.cycles})
         self.n, self.rejected, self.elapsed = 0, 0, 0.0
         self.h_m = np.zeros(setup.grid.shape)
         self.h_s = np.zeros(setup.grid.shape)
         self.p = self.p_prev = None
+        self.r_m = self.r_s = None  # wear per cycle at the current state (the current cycle's)
+        self.work = self.rate_work = 0.0  # accumulated invariant, and its rate per cycle at the current state
+        self.memory: dict = {}  # the cycle model's own memory (its lagged slips)
+        self.cyc: Optional[Cycle] = None
         self.d_prev = 1
         self.jump = 1.0
         self.lag = 0.0  # pressure lag per cycle of step (the last step's estimate / its length)
         self.err_abs_m = self.err_abs_s = 0.0  # accumulated local depth errors (mm, L2)
-        self.history: list = []  # implicit schemes: (N, φ_m, φ_s, p)
-        self.batch: list = []  # adaptive scheme: wear at the last linear steps
+        self.history: list = []  # implicit schemes: (N, φ_m, φ_s, p, φ_work)
+        self.batch: list = []  # adaptive scheme: (wear m, wear s, work) at the last linear steps
         self.watch = GrowthWatch()
 
     # -- checkpoint -------------------------------------------------------------------------------------------
     def state(self) -> dict:
         st = {k: getattr(self, k) for k in self.STATE}
         st["elapsed"] = self.elapsed + time.perf_counter() - self.t0
-        st["batch"] = [a for pair in self.batch for a in pair]  # flat list of arrays: m0, s0, m1, s1, ...
+        st["batch"] = [a for b in self.batch for a in b[:2]]  # flat list of arrays: m0, s0, m1, s1, ...
+        st["batch_work"] = np.array([b[2] for b in self.batch], dtype=float)
         st["history_n"] = np.array([h[0] for h in self.history], dtype=np.int64)
-        st["history"] = [a for h in self.history for a in h[1:]]  # φ_m, φ_s, p per point
+        st["history"] = [a for h in self.history for a in h[1:4]]  # φ_m, φ_s, p per point
+        st["history_work"] = np.array([h[4] for h in self.history], dtype=float)
         st["watch"] = np.array(self.watch.history, dtype=float)
         st["scheme"] = self.s.scheme
+        for k, v in self.memory.items():
+            st["memory_" + k] = v
         return st
 
     def restore(self, st: dict) -> None:
@@ -196,65 +209,76 @@ class _Loop:
         self.n, self.rejected, self.d_prev = int(self.n), int(self.rejected), int(self.d_prev)
         self.jump, self.elapsed, self.lag = float(self.jump), float(self.elapsed), float(self.lag)
         self.err_abs_m, self.err_abs_s = float(self.err_abs_m), float(self.err_abs_s)
+        self.work, self.rate_work = float(self.work), float(self.rate_work)
+        self.memory = {k[len("memory_"):]: v for k, v in st.items() if k.startswith("memory_")}
         flat = list(st.get("batch", []))
-        self.batch = [(flat[i], flat[i + 1]) for i in range(0, len(flat), 2)]
+        works = list(np.atleast_1d(st.get("batch_work", np.zeros(len(flat) // 2))))
+        self.batch = [(flat[i], flat[i + 1], float(works[i // 2])) for i in range(0, len(flat), 2)]
         ns = [int(v) for v in np.atleast_1d(st.get("history_n", []))]
         arrays = list(st.get("history", []))
-        self.history = [(ns[i], arrays[3 * i], arrays[3 * i + 1], arrays[3 * i + 2]) for i in range(len(ns))]
+        hw = list(np.atleast_1d(st.get("history_work", np.zeros(len(ns)))))
+        self.history = [(ns[i], arrays[3 * i], arrays[3 * i + 1], arrays[3 * i + 2], float(hw[i]))
+                        for i in range(len(ns))]
         self.watch = GrowthWatch(np.atleast_1d(st.get("watch", [])))
+        self.cyc = None  # rebuilt only if needed (a run resumed at its end)
+        if "r_m" not in st:  # a checkpoint of format 1.2, which only had uniform slip: the rates follow from p
+            cyc = self._restored_cycle()
+            self.r_m, self.r_s, self.rate_work = cyc.rate_moving, cyc.rate_stationary, cyc.work
         self.t0 = time.perf_counter()
 
     # -- the contact solve, on the fine grid or on the coarse one with refinement (Eqs. 11-12) ----------------
-    def contact(self, cycle: int, guess, h_m=None, h_s=None, implicit: float = 0.0):
-        """The pressure for the gap with wear (h_m, h_s) (default: the current state), and the solver's result.
-
-        With ``implicit`` = s > 0 the compliance is C + s·W: the pressure p_{n+1} of a step whose wear is
-        (h_m, h_s) + s·rates(p_{n+1}).
-        """
+    def normal(self, seen, guess, extra=None, load: Optional[float] = None, cycle: int = 0):
+        """The normal contact for the gap ε + ``seen`` (mm, on the fine grid): its pressure on the fine grid and the
+        solver's result.  ``extra`` is an operator added to the compliance (an implicit step's wear term s·W on
+        the solve grid); ``load`` on the grid.  Every failure is a :class:`NumericalFailure`."""
         s = self.s
-        seen = gap_wear(self.h_m if h_m is None else h_m, self.h_s if h_s is None else h_s, s.grid.dx, s.stroke,
-                        s.gap_model)
         if s.coarse is not None:
             op, gap = s.coarse_compliance, s.coarse_gap + coarsen(seen, s.grid, s.coarse)
             guess = None if guess is None else coarsen(guess, s.grid, s.coarse)
         else:
             op, gap = s.compliance, s.gap + seen
-        if implicit:
-            op = add(op, scaled(s.wear_op, implicit))
-        res = solve(op, gap, s.load, method=s.method, p0=guess, tol=s.tolerance)
+        if extra is not None:
+            op = add(op, extra)
+        res = solve(op, gap, load, method=s.method, p0=guess, tol=s.tolerance)
         if not res.success:
             raise NumericalFailure(f"the contact solve did not converge at cycle {cycle}: {res.message}", self.n)
         if not np.isfinite(res.pressure).all():
             raise NumericalFailure(f"non-finite pressure from the {s.method} solver at cycle {cycle}", self.n)
         if (res.pressure < 0).any():
             raise NumericalFailure(f"negative pressure from the {s.method} solver at cycle {cycle}", self.n)
-        imbalance = float(res.pressure.sum()) * op.grid.area / s.load - 1.0
+        imbalance = float(res.pressure.sum()) * op.grid.area / load - 1.0
         if abs(imbalance) > LOAD_BALANCE:
             raise NumericalFailure(f"the {s.method} solution at cycle {cycle} violates the load balance by "
                                    f"{imbalance:.1e} (relative): the Archard invariant would break", self.n)
         p = res.pressure if s.coarse is None else refine_pressure(res.pressure, s.coarse, s.grid)
-        _check_edges(p, self.band, s.grid, cycle, s)
+        _check_edges(p, s.band, s.grid, cycle, s)
         return p, res
 
-    def rates(self, p):
-        """Wear per cycle of the moving and the stationary body for pressure p (Eqs. 15-16 with ΔN = 1)."""
-        s = self.s
-        return wear_rates(p, s.grid.dx, s.stroke, s.k_moving, s.k_stationary)
+    def cycle_at(self, cycle: int, guess, h_m=None, h_s=None, implicit: float = 0.0) -> Cycle:
+        """One representative cycle at the wear (h_m, h_s) (default: the current state).
+
+        With ``implicit`` = s > 0 it is an implicit step's: the contact anticipates s cycles of its own wear, so the
+        wear (h_m, h_s) + s·rates is the one its pressure belongs to.
+        """
+        return self.model.solve(self.h_m if h_m is None else h_m, self.h_s if h_s is None else h_s, self.normal,
+                                guess, step=implicit, memory=self.memory, cycle=cycle)
 
     def next_stop(self) -> int:
         return next(t for t in self.stops if t > self.n)
 
-    def emit(self, p, res, jump: int, error_pressure: float = 0.0) -> Step:
+    def emit(self, cyc: Cycle, jump: int, error_pressure: float = 0.0) -> Step:
         s = self.s
-        self.p = p
-        step = _record(s, self.n, self.h_m, self.h_s, p, res, self.t0 - self.elapsed)
+        self.cyc = cyc
+        self.p, self.r_m, self.r_s, self.memory = cyc.pressure, cyc.rate_moving, cyc.rate_stationary, cyc.memory
+        self.rate_work = cyc.work
+        step = _record(s, self.n, self.h_m, self.h_s, cyc, self.work, self.t0 - self.elapsed)
         step.jump, step.rejected = jump, self.rejected
         step.error_depth = max(_rel_scalar(self.err_abs_m, self.h_m), _rel_scalar(self.err_abs_s, self.h_s))
         step.error_pressure = error_pressure
         self.rejected = 0
         if step.archard_error > ARCHARD_ROUND_OFF:
-            raise NumericalFailure(f"the Archard invariant is broken at cycle {self.n}: wear volume differs from "
-                                   f"k·P·4δ·N by {step.archard_error:.2e} (relative)", self.n)
+            raise NumericalFailure(f"the wear invariant is broken at cycle {self.n}: the wear volume differs from "
+                                   f"{self.model.invariant} by {step.archard_error:.2e} (relative)", self.n)
         if self.n > 0 and self.watch.update(step.checkerboard) and s.watch_growth:
             if s.scheme in ("linear", "adaptive"):
                 cause = (f"the {'linear jump ' + str(s.linear_jump) + ' cycles' if s.scheme == 'linear' else 'adaptive jumps'}"
@@ -262,8 +286,8 @@ class _Loop:
                          f"jumping.scheme: bdf2 (no stability limit), or a smaller jumping.linear")
             else:
                 cause = (f"the implicit steps have no stability limit, so the model itself is unstable here (explicit "
-                         f"limit {s.stability_limit:.4g} cycles, gap model {s.gap_model}): check the wear coefficients "
-                         f"and their units")
+                         f"limit {s.stability_limit:.4g} cycles, gap model {getattr(self.model, 'gap_model', '–')}): "
+                         f"check the wear coefficients and their units")
             raise NumericalFailure(
                 f"the pressure checkerboards at cycle {self.n}: an odd-even pattern grew over the last steps "
                 f"(amplitude {abs(step.checkerboard):.1%} of the mean pressure); {cause}", self.n)
@@ -272,15 +296,20 @@ class _Loop:
             obs.on_step(s, step)
         if self.progress is not None and jump:
             self.progress(jump)
-        self._check_body(p)
+        self._check_body(self.p)
         return step
 
+    def _restored_cycle(self) -> Cycle:
+        """The cycle at the restored state: rebuilt from its pressure where the rates are linear in it, else solved
+        again from it."""
+        if self.model.linear:
+            return self.model.restore(self.p)
+        return self.cycle_at(self.n, self.p)
+
     def current_step(self) -> Step:
-        """The current state as a step record, without a solve (a resumed run at its end)."""
-        from fretsim.solvers.result import ContactResult
-        p = self.p
-        res = ContactResult(p, float("nan"), p > 0, 0, True, "restored from the checkpoint")
-        step = _record(self.s, self.n, self.h_m, self.h_s, p, res, self.t0 - self.elapsed)
+        """The current state as a step record, without stepping (a resumed run at its end)."""
+        self.cyc = self.cyc or self._restored_cycle()
+        step = _record(self.s, self.n, self.h_m, self.h_s, self.cyc, self.work, self.t0 - self.elapsed)
         step.error_depth = max(_rel_scalar(self.err_abs_m, self.h_m), _rel_scalar(self.err_abs_s, self.h_s))
         step.state = self.state()
         return step
@@ -305,23 +334,23 @@ class _Loop:
                                 f"{self.n} (wear depth {depth * 1e3:.4g} µm), half the radius {2 * r:.4g} mm: beyond "
                                 f"it the body's worn shape is no longer the paraboloid this model assumes", self.n)
 
-    def advance(self, dh_m, dh_s, d_n: int) -> None:
+    def advance(self, dh_m, dh_s, d_n: int, d_work: float) -> None:
         if (dh_m < 0).any() or (dh_s < 0).any():
             raise NumericalFailure(f"negative wear increment at cycle {self.n + d_n}", self.n)
         self.h_m = self.h_m + dh_m
         self.h_s = self.h_s + dh_s
+        self.work = self.work + d_work
         self.n += d_n
 
     def run(self, resume: Optional[dict] = None) -> Step:
         s = self.s
         step = None
         if resume is None:
-            p, res = self.contact(0, None)
-            _check_resolution(res, s)
-            r_m, r_s = self.rates(p)
+            cyc = self.cycle_at(0, None)
+            _check_resolution(cyc.contact, s)
             c = 0.5 if s.per_cycle else 0.0
-            self.history = [(0, c * r_m, c * r_s, p)]  # φ = h + ½r at N = 0
-            step = self.emit(p, res, 0)
+            self.history = [(0, c * cyc.rate_moving, c * cyc.rate_stationary, cyc.pressure, c * cyc.work)]  # φ = h + ½r
+            step = self.emit(cyc, 0)
         else:
             self.restore(resume)
             if self.n >= s.cycles:  # killed as it finished: the state is the last step
@@ -333,26 +362,26 @@ class _Loop:
         return {"linear": self._linear, "adaptive": self._adaptive}[s.scheme]() or step
 
     # -- explicit schemes (the paper's) ---------------------------------------------------------------------
-    def _explicit_step(self, d_n):
-        r_m, r_s = self.rates(self.p)
+    def _explicit_step(self, d_n) -> tuple[Cycle, float]:
+        r_m, r_s = self.r_m, self.r_s
         p_old = self.p
-        self.advance(r_m * d_n, r_s * d_n, d_n)
+        self.advance(r_m * d_n, r_s * d_n, d_n, self.rate_work * d_n)
         # predictor: extrapolate the pressure history so the warm start begins closer to the answer
         guess = p_old if self.p_prev is None else np.clip(p_old + (p_old - self.p_prev) * (d_n / self.d_prev), 0, None)
-        p_new, res = self.contact(self.n, guess)
+        cyc = self.cycle_at(self.n, guess)
         self.p_prev, self.d_prev = p_old, d_n
         # forward Euler with ΔN against the per-cycle update: local error ≈ ½(ΔN − 1)·ΔN·ṙ
-        r2_m, r2_s = self.rates(p_new)
+        r2_m, r2_s = cyc.rate_moving, cyc.rate_stationary
         self.err_abs_m += 0.5 * (d_n - 1) * float(np.linalg.norm(r2_m - r_m))
         self.err_abs_s += 0.5 * (d_n - 1) * float(np.linalg.norm(r2_s - r_s))
-        return p_new, res, 0.5 * _rel(p_new - p_old, p_new)
+        return cyc, 0.5 * _rel(cyc.pressure - p_old, cyc.pressure)
 
     def _linear(self) -> Step:
         step = None
         while self.n < self.s.cycles:
             d_n = min(self.s.linear_jump, self.next_stop() - self.n)
-            p, res, e_p = self._explicit_step(d_n)
-            step = self.emit(p, res, d_n, e_p)
+            cyc, e_p = self._explicit_step(d_n)
+            step = self.emit(cyc, d_n, e_p)
         return step
 
     def _adaptive(self) -> Step:
@@ -363,17 +392,17 @@ class _Loop:
         and more than twice what it was) or whose solve fails is undone and retried at half the length
         (counted as rejected); below the linear jump it becomes a linear step.  The linear steps that follow
         damp what remains.  Jumps never end on a snapshot or the last cycle: those are reached by linear
-        steps, so recorded states are stabilised.
+        steps, so recorded states are stabilised.  The invariant's work is extrapolated with the wear.
         """
         s = self.s
         lin = s.linear_jump
         step = None
         if not self.batch:
-            self.batch = [(self.h_m, self.h_s)]
+            self.batch = [(self.h_m, self.h_s, self.work)]
         while self.n < s.cycles:
             room = self.next_stop() - self.n
             if len(self.batch) > Q_LINEAR and room > (Q_LINEAR + 1) * lin:
-                (m2, s2), (m1, s1), (m0, s0) = self.batch[-3:]
+                (m2, s2, w2), (m1, s1, w1), (m0, s0, w0) = self.batch[-3:]
                 jump = min(taylor_jump([(m2, m1, m0), (s2, s1, s0)], lin, s.eta, s.max_jump or 600),
                            room - Q_LINEAR * lin)
                 before = abs(self.watch.history[-1]) if self.watch.history else 0.0
@@ -383,33 +412,34 @@ class _Loop:
                     if not ((new_m >= m0).all() and (new_s >= s0).all()):
                         jump //= 2  # the quadratic term must not make an increment negative
                         continue
-                    saved = (self.h_m, self.h_s, self.n)
-                    self.advance(new_m - m0, new_s - s0, jump)
+                    saved = (self.h_m, self.h_s, self.n, self.work)
+                    self.advance(new_m - m0, new_s - s0, jump, taylor_extrapolate(w2, w1, w0, lin, jump) - w0)
                     try:
-                        p_jump, res = self.contact(self.n, self.p)
-                        amp = abs(checkerboard_signed(res.pressure))
+                        cyc = self.cycle_at(self.n, self.p)
+                        amp = abs(checkerboard_signed(cyc.contact.pressure))
                         unstable = amp > max(NOISE_FLOOR, 2.0 * before)
                     except NumericalFailure:
                         unstable = True
                     if unstable:
-                        self.h_m, self.h_s, self.n = saved
+                        self.h_m, self.h_s, self.n, self.work = saved
                         self.rejected += 1
                         jump //= 2
                         continue
                     self.p_prev = None
-                    self.batch = [(self.h_m, self.h_s)]
+                    self.batch = [(self.h_m, self.h_s, self.work)]
                     self.watch.reset()  # a jump is not a step of the linear sequence whose growth is watched
-                    step = self.emit(p_jump, res, jump, 0.5 * _rel(p_jump - self.p, p_jump))
+                    step = self.emit(cyc, jump, 0.5 * _rel(cyc.pressure - self.p, cyc.pressure))
                     break
                 else:
-                    self.batch = [(self.h_m, self.h_s)]
+                    self.batch = [(self.h_m, self.h_s, self.work)]
                 if jump > lin:
                     continue
             d_n = min(lin, room)
-            p, res, e_p = self._explicit_step(d_n)
+            cyc, e_p = self._explicit_step(d_n)
             # a shortened step breaks the equal spacing the differences need: restart the batch
-            self.batch = self.batch + [(self.h_m, self.h_s)] if d_n == lin else [(self.h_m, self.h_s)]
-            step = self.emit(p, res, d_n, e_p)
+            here = (self.h_m, self.h_s, self.work)
+            self.batch = self.batch + [here] if d_n == lin else [here]
+            step = self.emit(cyc, d_n, e_p)
         return step
 
     # -- implicit schemes: backward Euler (order 1) and variable-step BDF2 (order 2) --------------------------
@@ -444,11 +474,12 @@ class _Loop:
         """One cycle of the model itself (the per-cycle update, explicit and stable at one cycle).  The first
         cycles change the pressure by ~0.5 % each, too fast for the modified equation the implicit schemes
         integrate; taken one by one they are exact and cost what steps of one cycle would."""
-        p_new, res, e_p = self._explicit_step(1)
-        r_m, r_s = self.rates(p_new)
+        cyc, e_p = self._explicit_step(1)
+        r_m, r_s = cyc.rate_moving, cyc.rate_stationary
         self.jump, self.lag = 2.0, e_p
-        self.history = (self.history + [(self.n, self.h_m + 0.5 * r_m, self.h_s + 0.5 * r_s, p_new)])[-HISTORY_POINTS:]
-        return self.emit(p_new, res, 1, e_p)
+        self.history = (self.history + [(self.n, self.h_m + 0.5 * r_m, self.h_s + 0.5 * r_s, cyc.pressure,
+                                          self.work + 0.5 * cyc.work)])[-HISTORY_POINTS:]
+        return self.emit(cyc, 1, e_p)
 
     def _implicit(self, order: int) -> Step:
         """Implicit steps of φ = h + ½r (see :mod:`fretsim.jumping`), one contact solve each, under control.
@@ -469,7 +500,7 @@ class _Loop:
                 step = self._exact_cycle()
                 continue
             d, constrained = self._step_size(order)
-            n_now, phi_m, phi_s, p_now = self.history[-1]
+            n_now, phi_m, phi_s, p_now, phi_w = self.history[-1]
             partner = None
             if order == 2:
                 for k in range(len(self.history) - 2, -1, -1):
@@ -478,16 +509,17 @@ class _Loop:
                         break
             if partner is None:
                 b, g = 0.0, 1.0
-                base_m, base_s = phi_m, phi_s
+                base_m, base_s, base_w = phi_m, phi_s, phi_w
             else:
-                n_k, k_m, k_s, _ = self.history[partner]
+                n_k, k_m, k_s, _, k_w = self.history[partner]
                 b, g = bdf2_coefficients(d, n_now - n_k)
                 base_m, base_s = phi_m + b * (phi_m - k_m), phi_s + b * (phi_s - k_s)
+                base_w = phi_w + b * (phi_w - k_w)
             half = 0.5 if s.per_cycle else 0.0
             coef = g * d - half
             guess = self._predict(self.n + d)
             try:
-                p_new, res = self.contact(self.n + d, guess, base_m, base_s, implicit=coef)
+                cyc = self.cycle_at(self.n + d, guess, base_m, base_s, implicit=coef)
             except NumericalFailure:
                 if d == 1 or retries >= MAX_RETRIES:
                     raise
@@ -495,8 +527,9 @@ class _Loop:
                 self.rejected += 1
                 self.jump = max(1.0, d / 4)
                 continue
-            r_m, r_s = self.rates(p_new)
+            p_new, r_m, r_s = cyc.pressure, cyc.rate_moving, cyc.rate_stationary
             new_phi_m, new_phi_s = base_m + g * d * r_m, base_s + g * d * r_s
+            new_phi_w = base_w + g * d * cyc.work
             h_m, h_s = new_phi_m - half * r_m, new_phi_s - half * r_s
             # local error estimates (absolute, L2) of each body
             # depth: the local error of each body's deepest element (the reported depth), held to DEPTH_SHARE of
@@ -512,7 +545,7 @@ class _Loop:
                 k_order = 2
             else:
                 inner = (p_now > 0) & (p_new > 0)
-                r0_m, r0_s = self.rates(p_now)
+                r0_m, r0_s = self.r_m, self.r_s  # the rates at the current state, history[-1]
                 e_m, e_s, k_order = 0.5 * d * (r_m - r0_m)[inner], 0.5 * d * (r_s - r0_s)[inner], 1
             err_m, err_s = _at_deepest(e_m, h_m[inner]), _at_deepest(e_s, h_s[inner])
             error = max(_rel_scalar(err_m, _amax(h_m)), _rel_scalar(err_s, _amax(h_s))) / DEPTH_SHARE
@@ -530,11 +563,11 @@ class _Loop:
             self.err_abs_m += err_m
             self.err_abs_s += err_s
             self.lag = e_p / d
-            self.advance(h_m - self.h_m, h_s - self.h_s, d)
-            self.history = (self.history + [(self.n, new_phi_m, new_phi_s, p_new)])[-HISTORY_POINTS:]
+            self.advance(h_m - self.h_m, h_s - self.h_s, d, new_phi_w - half * cyc.work - self.work)
+            self.history = (self.history + [(self.n, new_phi_m, new_phi_s, p_new, new_phi_w)])[-HISTORY_POINTS:]
             proposal = next_step(d, error, tol, k_order)
             self.jump = max(self.jump, proposal) if constrained else proposal
-            step = self.emit(p_new, res, d, e_p)
+            step = self.emit(cyc, d, e_p)
         return step
 
 
@@ -584,20 +617,20 @@ def _check_edges(p: np.ndarray, band: int, grid: Grid, cycle: int, setup: Setup)
                           f"sizing", cycle)
 
 
-def _record(setup: Setup, cycle: int, h_m, h_s, p, res, t0) -> Step:
+def _record(setup: Setup, cycle: int, h_m, h_s, cyc: Cycle, work: float, t0) -> Step:
     area = setup.grid.area * setup.volume_factor
     v_m = float(h_m.sum()) * area
     v_s = float(h_s.sum()) * area
     err = 0.0
     if cycle > 0:
-        expect_m = archard_volume(setup.k_moving, setup.total_load, cycle, setup.stroke)
-        expect_s = archard_volume(setup.k_stationary, setup.total_load, cycle, setup.stroke)
+        expect_m, expect_s = setup.cycle.expected_volumes(cycle, work)
         err = max(abs(v_m / expect_m - 1) if expect_m else abs(v_m),
                   abs(v_s / expect_s - 1) if expect_s else abs(v_s))
-    return Step(cycle=cycle, wear_moving=h_m, wear_stationary=h_s, pressure=p,
-                pressure_average=stroke_average(p, setup.grid.dx, setup.stroke), iterations=res.iterations,
+    res = cyc.contact
+    return Step(cycle=cycle, wear_moving=h_m, wear_stationary=h_s, pressure=cyc.pressure,
+                pressure_average=cyc.pressure_stationary, cycle_result=cyc, iterations=cyc.iterations,
                 wall_time=time.perf_counter() - t0, approach=res.approach, is_snapshot=cycle in setup.snapshots,
-                volume_moving=v_m, volume_stationary=v_s, archard_error=err,
+                volume_moving=v_m, volume_stationary=v_s, archard_error=err, work=work,
                 # on the grid the contact is solved on: with refinement the fine pressure is smooth by construction
                 checkerboard=checkerboard_signed(res.pressure))
 

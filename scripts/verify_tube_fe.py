@@ -203,7 +203,7 @@ def main() -> int:
     c_flat = strip_plane_strain(ox, dx / 2, e_flat)
 
     say(f"tube {geom['outer']} / {geom['inner']} mm (Inconel 690, E {geom['youngs'] / 1e3:g} GPa), 405 SS flat; "
-        f"2D grid of {x.size} elements of {dx * 1e3:.2f} µm; load {setup90.load:.4g} N/mm")
+        f"2D grid of {x.size} elements of {dx * 1e3:.2f} µm; load {setup90.cycle.load:.4g} N/mm")
     say("FE: plane strain, quadratic quadrilaterals, the bottom half of the ring, symmetric about the horizontal "
         "diameter")
     fe = {}
@@ -222,10 +222,10 @@ def main() -> int:
     say("1. Unworn contact (N = 0), one solve on the same gap: pressure against the FE tube's (fine mesh)")
     say(f"{'model':<38}{'L2':>9}{'peak':>9}{'width':>8}")
     gap0 = setup90.gap.ravel()
-    ref0 = contact(c_flat + fe[4], gap0, setup90.load, dx)
+    ref0 = contact(c_flat + fe[4], gap0, setup90.cycle.load, dx)
     c_fretsim_bending = None
     for label, c in (("FE tube, coarse mesh (its own error)", c_flat + fe[2]),):
-        d = pressure_difference(contact(c, gap0, setup90.load, dx), ref0)
+        d = pressure_difference(contact(c, gap0, setup90.cycle.load, dx), ref0)
         say(f"{label:<38}{d['l2']:>9.2%}{d['peak']:>+9.2%}{d['width']:>+8.0f}")
     results = {}
     for name in ("tube_RT", "tube_90C"):
@@ -236,7 +236,7 @@ def main() -> int:
         c = results["tube_RT", model][0].compliance.dense()
         if "bending" in model:
             c_fretsim_bending = c
-        d = pressure_difference(contact(c, gap0, setup90.load, dx), ref0)
+        d = pressure_difference(contact(c, gap0, setup90.cycle.load, dx), ref0)
         say(f"{model:<38}{d['l2']:>9.2%}{d['peak']:>+9.2%}{d['width']:>+8.0f}")
 
     say()
@@ -265,14 +265,14 @@ def main() -> int:
     say("   pressure is sensitive to the compliance, which is why the runs' own pressures (2.) are the comparison")
     _, ref_last, _ = results["tube_RT", "FE tube + half-plane flat"]
     setup_fe = results["tube_RT", "FE tube + half-plane flat"][0]
-    gap_w = gap0 + gap_wear(ref_last.wear_moving, ref_last.wear_stationary, dx, setup_fe.stroke,
-                            setup_fe.gap_model).ravel()
-    ref_w = contact(c_flat + fe[4], gap_w, setup90.load, dx)
+    gap_w = gap0 + gap_wear(ref_last.wear_moving, ref_last.wear_stationary, dx, setup_fe.cycle.stroke,
+                            setup_fe.cycle.gap_model).ravel()
+    ref_w = contact(c_flat + fe[4], gap_w, setup90.cycle.load, dx)
     say(f"   FE re-solve against the run's own pressure: L2 "
         f"{np.linalg.norm(ref_w - ref_last.pressure.ravel()) / np.linalg.norm(ref_w):.2%}")
     for label, c in (("FE tube, coarse mesh (its own error)", c_flat + fe[2]),
                      ("fretsim: half-planes + ring bending", c_fretsim_bending)):
-        d = pressure_difference(contact(c, gap_w, setup90.load, dx), ref_w)
+        d = pressure_difference(contact(c, gap_w, setup90.cycle.load, dx), ref_w)
         say(f"   {label:<38}{d['l2']:>9.2%}{d['peak']:>+9.2%}{d['width']:>+8.0f}")
     say.write(OUT / "verify_tube_fe.txt")
 
@@ -284,7 +284,7 @@ def main() -> int:
     nz = np.flatnonzero(ref0 > 0)
     sl = slice(max(0, nz[0] - 8), min(x.size, nz[-1] + 9))
     ax.plot(x[sl] * 1e3, ref0[sl], "k-", lw=1.6, label="FE tube + half-plane flat")
-    ax.plot(x[sl] * 1e3, contact(c_fretsim_bending, gap0, setup90.load, dx)[sl], "C1--", label="fretsim (+ C_b)")
+    ax.plot(x[sl] * 1e3, contact(c_fretsim_bending, gap0, setup90.cycle.load, dx)[sl], "C1--", label="fretsim (+ C_b)")
     ax.set_title("unworn (N = 0)", fontsize=9)
     for ax, name in zip(axes[1:], ("tube_RT", "tube_90C")):
         for (n, model), p in fields.items():

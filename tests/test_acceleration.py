@@ -100,11 +100,11 @@ def test_either_body_with_a_zero_wear_coefficient_completes_with_the_default_sch
     assert out.summary["archard_volume_error"] < 1e-9
     # the paper's gap model is kept wherever it is stable on the grid, and replaced (with the reason) where not:
     # without wear of the moving body it is unstable whenever the stroke average has negative modes on the grid
-    paper = wear_spectrum(out.setup.compliance, out.setup.stroke, out.setup.k_moving, out.setup.k_stationary,
-                          "mid_stroke")
-    assert out.setup.gap_model == ("stroke_average" if paper.growth_rate > 0 else "mid_stroke")
-    if body == "moving" and out.setup.stroke > 1.5 * out.setup.grid.dx:
-        assert out.setup.gap_model == "stroke_average"
+    model = out.setup.cycle
+    paper = wear_spectrum(out.setup.compliance, model.stroke, model.k_moving, model.k_stationary, "mid_stroke")
+    assert model.gap_model == ("stroke_average" if paper.growth_rate > 0 else "mid_stroke")
+    if body == "moving" and model.stroke > 1.5 * out.setup.grid.dx:
+        assert model.gap_model == "stroke_average"
 
 
 def test_the_papers_gap_model_forced_where_it_is_unstable_is_refused_with_advice_that_runs():

@@ -1,0 +1,79 @@
+"""``uniform``: the paper's fretting cycle — gross slip everywhere, the pressure solved once at mid-stroke.
+
+Every point in contact slides the full stroke, 4δ per cycle (the bodies are rigid tangentially); the moving
+body wears with its own pressure and the flat with the stroke-averaged one (Eqs. 15–16, :mod:`fretsim.wear`).
+How the flat's wear enters the mid-stroke gap is ``gap_model`` (Eq. 18, or its stroke average).  The rates are
+linear in the pressure: W = 4δ(k_m I + k_s B), so an implicit step solves the contact with C + s·W and is exact.
+Invariant: each body's wear volume is k·P·4δ·N.  With a friction coefficient the cycle also reports what gross
+slip implies (shear traction μp, tangential force μP, energy 4μPδ per cycle); without one those are NaN.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+import numpy as np
+
+from fretsim.compliance import scaled
+from fretsim.cycle import Cycle
+from fretsim.grid import Grid
+from fretsim.solvers.result import ContactResult
+from fretsim.wear import archard_volume, gap_wear, stroke_average, wear_rates
+
+
+@dataclass(frozen=True)
+class UniformCycle:
+    """The paper's cycle.  ``k_moving``/``k_stationary`` are the coefficients of p·ds in the wear law (Archard's k,
+    or α·μ for the energy law, which equals it in gross slip)."""
+
+    grid: Grid  # the fine grid (wear, rates)
+    wear_op: object  # W on the grid the contact is solved on (fretsim.wear.wear_operator)
+    stroke: float  # mm
+    load: float  # on the grid: N (3D) or N/mm (2D)
+    total_load: float  # N
+    k_moving: float
+    k_stationary: float
+    gap_model: str
+    friction_coefficient: Optional[float] = None
+    name: str = "uniform"
+    linear: bool = True
+    invariant: str = "k·P·4δ·N"
+
+    def rates(self, pressure: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+        """Wear per cycle of the moving and the stationary body for the mid-stroke pressure (Eqs. 15–16)."""
+        return wear_rates(pressure, self.grid.dx, self.stroke, self.k_moving, self.k_stationary)
+
+    def stiffness(self):
+        return self.wear_op
+
+    def solve(self, wear_moving, wear_stationary, normal, guess, step: float = 0.0, memory=None,
+              cycle: int = 0) -> Cycle:
+        seen = gap_wear(wear_moving, wear_stationary, self.grid.dx, self.stroke, self.gap_model)
+        p, res = normal(seen, guess, scaled(self.wear_op, step) if step else None, load=self.load, cycle=cycle)
+        return self._cycle(p, res)
+
+    def restore(self, pressure: np.ndarray) -> Cycle:
+        """The cycle of a mid-stroke pressure read back from a checkpoint (no solve: everything follows from p)."""
+        return self._cycle(pressure, ContactResult(pressure, float("nan"), pressure > 0, 0, True,
+                                                   "restored from the checkpoint"))
+
+    def _cycle(self, p: np.ndarray, res: ContactResult) -> Cycle:
+        r_m, r_s = self.rates(p)
+        p_av = stroke_average(p, self.grid.dx, self.stroke)
+        travel = 4.0 * self.stroke
+        mu = self.friction_coefficient
+        nan = float("nan")
+        return Cycle(
+            pressure=p, pressure_stationary=p_av, rate_moving=r_m, rate_stationary=r_s,
+            slip_moving=np.where(p > 0, travel, 0.0), slip_stationary=np.where(p_av > 0, travel, 0.0),
+            shear=mu * p if mu is not None else np.full(p.shape, nan),
+            energy=mu * self.total_load * travel if mu is not None else nan,
+            work=self.total_load * travel,
+            force_amplitude=mu * self.total_load if mu is not None else nan,
+            regime="gross_slip", stick_half_width_x=0.0, contact=res, iterations=res.iterations)
+
+    def expected_volumes(self, cycles: int, work: float) -> tuple[float, float]:
+        # closed form, not the accumulated work: the paper's invariant exactly
+        return (archard_volume(self.k_moving, self.total_load, cycles, self.stroke),
+                archard_volume(self.k_stationary, self.total_load, cycles, self.stroke))
+
