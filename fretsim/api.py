@@ -1,62 +1,26 @@
-"""The Python API the CLI wraps: load a case, check it, run it (or resume it), read the results.
+"""The Python API the CLI wraps: load a case, check it, run it (or resume it), read the results, sweep.
 
     >>> from fretsim.api import load_case, run, read_results
     >>> outcome = run(load_case("cases/mccoll_185N.yaml"), "out.h5")
     >>> outcome.summary["centre_wear_depth_stationary_um"]
     >>> table = sweep("cases/sweeps/mccoll_load_stroke.yaml", "load_stroke")   # every point, one table
     >>> table.rows[0]["centre_wear_depth_stationary_um"], table.to_xarray()
+
+A façade: running one case is :mod:`fretsim.runner`, sweeps are :mod:`fretsim.sweep` (which runs its points
+through the runner, not through this module).
 """
 from __future__ import annotations
 
-import signal
-import threading
-import time
-from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Optional
 
-import numpy as np
-
-from fretsim.case import GEOMETRY_KEYS, Case, CaseError, load_case, parse_case
-from fretsim.plan import Plan, prepare
-from fretsim.reference import effective_modulus
-from fretsim.results import (OutputBusy, OutputClaim, Results, ResultsIOError, ResultsWriter, check_output_path,
-                             read_results)
-from fretsim.simulate import (PhysicalLimit, ResolutionError, SimulationError, Setup, Step, simulate, summarize)
+from fretsim.case import Case, CaseError, load_case, parse_case
+from fretsim.results import Results, read_results
+from fretsim.runner import Outcome, check, inputs_of, resume, run
+from fretsim.simulate import SimulationError
 
 __all__ = ["Case", "CaseError", "Outcome", "Results", "SimulationError", "check", "load_case", "parse_case",
-           "read_results", "run", "resume", "inputs_of"]
-
-RESUMABLE = ("interrupted", "running")  # "running": the process was killed before it could say otherwise
-
-
-@dataclass
-class Outcome:
-    status: str  # complete | interrupted | failed | stopped (a physical limit) | io_error (the disk refused)
-    message: str
-    summary: dict
-    setup: Setup
-    case: Case  # with the automatic choices filled
-    output: Optional[Path]
-    last: Optional[Step] = None
-    notes: tuple = field(default_factory=tuple)
-    plan: Optional[Plan] = None
-    written: bool = False  # whether the results file holds this run's steps
-
-
-class _Counter:
-    """Counts solves and keeps the last step and the largest error estimates at recorded states."""
-
-    def __init__(self, solves: int = 0, errors: tuple = (0.0, 0.0)):
-        self.solves = solves
-        self.last = None
-        self.errors = tuple(errors)
-
-    def on_step(self, setup, step):
-        self.solves += 1
-        self.last = step
-        if step.is_snapshot:
-            self.errors = (max(self.errors[0], step.error_depth), max(self.errors[1], step.error_pressure))
+           "read_results", "run", "resume", "inputs_of", "sweep"]
 
 
 def sweep(sweep_file: str | Path, outdir: str | Path, *, jobs: int = 0, dask: Optional[str] = None,
@@ -65,229 +29,3 @@ def sweep(sweep_file: str | Path, outdir: str | Path, *, jobs: int = 0, dask: Op
     (:class:`fretsim.sweep.SweepOutcome`: ``rows``, ``counts``, ``to_pandas()``, ``to_xarray()``)."""
     from fretsim.sweep import load_sweep, run_sweep
     return run_sweep(load_sweep(sweep_file), outdir, jobs=jobs, dask=dask, overwrite=overwrite, progress=progress)
-
-
-def check(case: Case) -> tuple[Setup, Case, Plan]:
-    """Everything a run would decide, without running: the setup, the filled case and the plan of choices."""
-    return prepare(case)
-
-
-def inputs_of(case: Case) -> dict:
-    """The resolved inputs of a filled case: name → (value, units, long name), as recorded in /inputs."""
-    g = case.geometry
-    values: dict = {"geometry": (g.kind, "", "contact geometry")}
-    for key, spec in GEOMETRY_KEYS[g.kind].items():
-        value = getattr(g, key, None)
-        if value is None or isinstance(value, tuple):  # absent options; a profile table is in /case
-            continue
-        values[f"geometry_{key}"] = (value, "mm" if spec.kind == "length" else "", f"geometry {key.replace('_', ' ')}")
-    for body in ("moving", "stationary"):
-        m = getattr(case, body)
-        values[f"{body}_youngs_modulus"] = (m.youngs_modulus / 1e3, "GPa", f"Young's modulus, {body} body")
-        values[f"{body}_poissons_ratio"] = (m.poissons_ratio, "1", f"Poisson's ratio, {body} body")
-        values[f"{body}_wear_coefficient"] = (m.wear_coefficient, "1/MPa", f"wear coefficient, {body} body")
-    values.update({
-        "normal_load": (case.normal_load, "N", "normal load"),
-        "stroke": (case.stroke * 1e3, "um", "slip amplitude"),
-        "cycles": (case.cycles, "cycles", "fretting cycles"),
-        "dimension": (case.dimension, "", "model dimension"),
-        "gap_model": (case.gap_model, "", "how the flat's wear enters the gap"),
-        "solver": (case.solver, "", "contact solver"),
-        "solver_tolerance": (case.tolerance, "1", "contact solver tolerance"),
-        "scheme": (case.scheme, "", "cycle-jumping scheme"),
-        "step_tolerance": (case.step_tolerance, "1", "target relative error (implicit schemes)"),
-        "linear_jump": (case.linear_jump or 0, "cycles", "linear cycle jump"),
-    })
-    if case.friction_coefficient is not None:
-        values["friction_coefficient"] = (case.friction_coefficient, "1", "friction coefficient")
-    e_star = effective_modulus(case.moving.youngs_modulus, case.moving.poissons_ratio,
-                               case.stationary.youngs_modulus, case.stationary.poissons_ratio)
-    h = g.hertz(case.normal_load, e_star)
-    values.update({"contact_modulus": (e_star / 1e3, "GPa", "contact modulus E*"),
-                   "hertz_half_width_x": (h.half_width_x, "mm", "Hertz contact half-width along x"),
-                   "hertz_half_width_y": (h.half_width_y, "mm", "Hertz contact half-width along y"),
-                   "hertz_peak_pressure": (h.peak_pressure, "MPa", "Hertz peak pressure"),
-                   "hertz_line_contact": (int(h.line), "1", "1 for a line contact (2D Hertz), 0 for a point contact")})
-    return {"values": values, "overrides": list(case.overrides), "case_file": case.source}
-
-
-def run(case: Case, output: Optional[str | Path] = None, *, overwrite: bool = False,
-        progress: Optional[Callable[[int], None]] = None, observers: tuple = (),
-        on_plan: Optional[Callable[[Setup, Case, Plan], None]] = None) -> Outcome:
-    """Run a case; write the results file if ``output`` is given.
-
-    Raises :class:`CaseError` for a case or an output that cannot be used (nothing is written then).  A run
-    that fails, stops at a physical limit or cannot write returns an outcome with that status; KeyboardInterrupt
-    is re-raised after the file is written with status ``interrupted``.  ``on_plan`` is called with the plan
-    before the first solve (the CLI prints the choices then).
-    """
-    setup, filled, plan = prepare(case)
-    claim = None
-    if output is not None:
-        try:
-            path = check_output_path(output, protect=(case.source,))
-        except ValueError as exc:
-            raise CaseError(str(output), [("", str(exc).removeprefix(f"{output} ").strip())], "output") from None
-        if path.exists() and not overwrite:
-            raise CaseError(str(output), [("", "the results file exists already; choose another -o, pass "
-                                               "--overwrite, or --resume it")], "output")
-        claim = _claim(path)
-        if path.exists() and not overwrite:  # appeared while we were claiming it
-            claim.release()
-            raise CaseError(str(output), [("", "the results file appeared while this run started; choose "
-                                               "another -o or pass --overwrite")], "output")
-    try:
-        if on_plan is not None:
-            on_plan(setup, filled, plan)
-        return _execute(setup, filled, plan, output, overwrite, progress, observers, resume_from=None)
-    finally:
-        if claim is not None:
-            claim.release()
-
-
-def _claim(path: Path) -> OutputClaim:
-    try:
-        return OutputClaim(path).acquire()
-    except OutputBusy as exc:
-        raise CaseError(str(path), [("", str(exc).removeprefix(f"{path}: "))], "output") from None
-    except OSError as exc:
-        raise CaseError(str(path), [("", f"cannot write in {path.parent or '.'}: {exc.strerror}")], "output") from None
-
-
-def resume(output: str | Path, *, progress: Optional[Callable[[int], None]] = None,
-           observers: tuple = ()) -> Outcome:
-    """Continue an interrupted (or killed) run from the last state in its results file.
-
-    The case is the one stored in the file, so the run continues exactly as it would have: the same steps,
-    the same arrays.  The file is verified first (structure, shapes, checksums): a damaged one is refused.
-    """
-    path = Path(output)
-    claim = _claim(path) if path.exists() else None
-    try:
-        try:
-            previous = read_results(output, for_resume=True)
-        except ValueError as exc:
-            raise CaseError(str(output), [("", str(exc).removeprefix(f"{output}: "))], "results file") from None
-        if previous.status not in RESUMABLE:
-            raise CaseError(str(output), [("", f"the run's status is {previous.status!r}; only an interrupted or "
-                                               f"killed run ({' or '.join(RESUMABLE)}) can be resumed")])
-        case = parse_case(previous.case_yaml, source=f"{output}:/case")
-        setup, filled, plan = prepare(case)
-        n = previous.checkpoint.get("n")
-        if not isinstance(n, int) or not 0 <= n <= setup.cycles:
-            raise CaseError(str(output), [("", f"/checkpoint: the cycle {str(n)[:20]} does not fit the case's "
-                                               f"{setup.cycles} cycles")], "results file")
-        return _execute(setup, filled, plan, output, True, progress, observers, resume_from=previous)
-    finally:
-        if claim is not None:
-            claim.release()
-
-
-def _execute(setup, filled, plan, output, overwrite, progress, observers, resume_from: Optional[Results]) -> Outcome:
-    counter = _Counter(len(resume_from.history["cycle"]) if resume_from is not None else 0,
-                       _recorded_errors(resume_from) if resume_from is not None else (0.0, 0.0))
-    writer = None
-    t0 = time.perf_counter()
-
-    class _LazyWriter:
-        """Creates the file at the first accepted step, so a case that fails its first solve writes nothing."""
-
-        def on_step(self, setup_, step):
-            nonlocal writer
-            if writer is None and output is not None:
-                writer = ResultsWriter(output, filled.to_yaml(), filled.name, setup.grid, setup.notes, overwrite,
-                                       previous=resume_from, choices=plan.choices, inputs=inputs_of(filled))
-            if writer is not None:
-                writer.on_step(setup_, step)
-
-    status, message = "complete", ""
-    state = resume_from.checkpoint if resume_from is not None else None
-    try:
-        last = simulate(setup, (counter, _LazyWriter()) + tuple(observers), progress, resume=state)
-        if counter.last is None and last is not None:  # resumed at its end: nothing left to do
-            counter.last = last
-            if output is not None and writer is None:
-                writer = ResultsWriter(output, filled.to_yaml(), filled.name, setup.grid, setup.notes, True,
-                                       previous=resume_from, choices=plan.choices, inputs=inputs_of(filled))
-                writer.state = resume_from.checkpoint
-    except ResolutionError as exc:  # found before anything is written: an input problem, named as such
-        given = any(c.key == "grid.elements" and c.given for c in plan.choices)
-        key = "grid.elements" if given else "grid"
-        advice = ("refine grid.elements or shrink grid.domain" if given else
-                  "the automatic grid should resolve it: set grid.domain and grid.elements explicitly")
-        raise CaseError(filled.source, [(key, f"{exc}; {advice}")]) from None
-    except ResultsIOError as exc:
-        cycle = _cycle_on_disk(writer)
-        where = (f"the file holds every step up to cycle {cycle} (status 'running'); when there is room, continue "
-                 f"with `fretsim run --resume {output}`" if cycle is not None else "nothing was written")
-        return Outcome("io_error", f"{exc.strerror}; {where}", _summary(setup, counter, t0), setup, filled,
-                       Path(output), counter.last, setup.notes, plan, cycle is not None)
-    except PhysicalLimit as exc:
-        status, message = "stopped", str(exc)
-    except SimulationError as exc:
-        status, message = "failed", str(exc)
-    except KeyboardInterrupt:
-        previous = _ignore_signals()  # a second Ctrl-C must not interrupt the write that records the first
-        try:
-            cycle = counter.last.cycle if counter.last else (int(state["n"]) if state else 0)
-            _finish(writer, setup, counter, t0, "interrupted", f"interrupted after cycle {cycle}; resume with "
-                                                               f"`fretsim run --resume {output}`")
-        except ResultsIOError:
-            pass  # the last good flush stays (status 'running'): still resumable
-        finally:
-            _restore_signals(previous)
-        raise
-    try:
-        _finish(writer, setup, counter, t0, status, message)
-    except ResultsIOError as exc:
-        cycle = _cycle_on_disk(writer)
-        return Outcome("io_error", f"{exc.strerror}; the file holds every step up to cycle {cycle} (status "
-                                   f"'running'); when there is room, continue with `fretsim run --resume {output}`",
-                       _summary(setup, counter, t0), setup, filled, Path(output), counter.last, setup.notes, plan,
-                       True)
-    return Outcome(status, message, _summary(setup, counter, t0), setup, filled, Path(output) if output else None,
-                   counter.last, setup.notes, plan, writer is not None)
-
-
-def _ignore_signals() -> dict:
-    """Ignore SIGINT and SIGTERM (main thread only); returns the handlers to restore."""
-    if threading.current_thread() is not threading.main_thread():
-        return {}
-    return {sig: signal.signal(sig, signal.SIG_IGN) for sig in (signal.SIGINT, signal.SIGTERM)}
-
-
-def _restore_signals(previous: dict) -> None:
-    for sig, handler in previous.items():
-        signal.signal(sig, handler)
-
-
-def _cycle_on_disk(writer) -> Optional[int]:
-    if writer is None or not writer.path.exists() or not writer._placed:
-        return None
-    try:
-        return int(read_results(writer.path).history["cycle"][-1])
-    except (ValueError, IndexError):
-        return None
-
-
-def _recorded_errors(previous: Results) -> tuple:
-    """The largest error estimates at the recorded states of an earlier part of the run."""
-    h = previous.history
-    if "error_estimate_depth" not in h or not len(h.get("cycle", [])):
-        return (0.0, 0.0)
-    at = np.isin(h["cycle"], previous.fields.get("cycle", []))
-    return (float(h["error_estimate_depth"][at].max(initial=0.0)),
-            float(h["error_estimate_pressure"][at].max(initial=0.0)))
-
-
-def _summary(setup, counter, t0) -> dict:
-    return summarize(setup, counter.last, counter.solves, _elapsed(counter, t0), counter.errors) if counter.last else {}
-
-
-def _elapsed(counter, t0) -> float:
-    return float(counter.last.state.get("elapsed", time.perf_counter() - t0)) if counter.last else 0.0
-
-
-def _finish(writer, setup, counter, t0, status, message):
-    if writer is not None:
-        writer.finish(status, message, _summary(setup, counter, t0))

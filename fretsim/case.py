@@ -18,8 +18,8 @@ from typing import Any, Optional
 
 import numpy as np
 
-from fretsim.geometry import (GEOMETRIES, BallOnFlat, CrossedCylinders, CylinderOnFlat, Geometry, RollerOnFlat,
-                              TubeOnFlat)
+from fretsim.errors import InputError
+from fretsim.geometry import GEOMETRIES, Geometry
 from fretsim.units import UnitError, format_quantity, parse_quantity
 from fretsim.yamlread import YamlProblem, excerpt, loads, read_text
 
@@ -89,7 +89,7 @@ GEOMETRY_KEYS: dict[str, dict[str, Key]] = {
         "block_length": Key("length", "the flat's length along y when it ends in free faces, centred on the "
                                       "roller (at least L); omitted: the flat runs on well beyond the contact", None,
                             plausible=LENGTH_RANGE),
-        "profile": Key("text", "a CSV of the axial profile drop: a header `y [unit], drop [unit]`, then rows "
+        "profile": Key("profile_file", "a CSV of the axial profile drop: a header `y [unit], drop [unit]`, then rows "
                                "(relative to the case file; mirrored if given for y ≥ 0 only)", None),
         "profile_table": Key("table", "the same profile inline: {y: [lengths], drop: [lengths]} (the filled case "
                                       "carries it, so a results file reruns without the CSV)", None)},
@@ -154,8 +154,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
 SECTIONS = ("name", "geometry", "materials", "loading", "model", "solver", "jumping", "grid", "output", "expected")
 
 
-class CaseError(Exception):
-    """A case that cannot be run: every problem with its YAML path."""
+class CaseError(InputError):
+    """A case (or a sweep file, an option, an output) that cannot be run: every problem with its YAML path."""
 
     def __init__(self, source: str, problems: list[tuple[str, str]], what: str = "case"):
         self.source = source
@@ -335,8 +335,9 @@ def _apply_override(raw: dict, item: str, problems: list) -> None:
 class _Reader:
     """Collects problems while reading typed values out of the raw mapping, as the schema says."""
 
-    def __init__(self, problems: list):
+    def __init__(self, problems: list, source: str = "<case>"):
         self.problems = problems
+        self.source = source  # the case file: relative file names in it are read from its directory
 
     def fail(self, path: str, msg: str) -> None:
         self.problems.append((path, msg))
@@ -414,6 +415,11 @@ class _Reader:
                 self.fail(path, f"expected a text, got {excerpt(value)}")
                 return None
             return value
+        if kind == "profile_file":
+            if not isinstance(value, str) or not value.strip():
+                self.fail(path, f"expected the name of a CSV file, got {excerpt(value)}")
+                return None
+            return _read_profile(value, self.source, self, path)
         if kind == "table":
             ok = isinstance(value, dict) and set(value) == {"y", "drop"} and all(
                 isinstance(value[k], list) and len(value[k]) >= 2 for k in ("y", "drop")) and len(value["y"]) == len(
@@ -498,7 +504,7 @@ class _Reader:
         return int(value)
 
 
-def _read_profile(name, source: str, r: "_Reader"):
+def _read_profile(name, source: str, r: "_Reader", key: str = "geometry.profile"):
     """(y, drop) in mm from a CSV whose header names the units: `y [mm], drop [um]`."""
     import csv
     import re
@@ -507,24 +513,24 @@ def _read_profile(name, source: str, r: "_Reader"):
     try:
         text = read_text(path, "profile file")
     except (OSError, ValueError) as exc:
-        r.fail("geometry.profile", f"{path}: {exc}")
-        return None, None
+        r.fail(key, f"{path}: {exc}")
+        return None
     rows = [row for row in csv.reader(text.splitlines()) if row and not row[0].lstrip().startswith("#")]
     head = [h.strip() for h in rows[0]] if rows else []
     units = [re.fullmatch(r"\w+\s*\[(.+)\]", h) for h in head[:2]]
     if len(head) < 2 or not all(units) or any(u.group(1) not in UNITS["length"] for u in units):
-        r.fail("geometry.profile", f"{path}: the first line must name the columns with length units, e.g. "
+        r.fail(key, f"{path}: the first line must name the columns with length units, e.g. "
                                    f"'y [mm], drop [um]'")
-        return None, None
+        return None
     scale = [UNITS["length"][u.group(1)] for u in units]
     try:
         data = np.array([[float(v) for v in row[:2]] for row in rows[1:]])
     except ValueError as exc:
-        r.fail("geometry.profile", f"{path}: a row is not two numbers ({exc})")
-        return None, None
+        r.fail(key, f"{path}: a row is not two numbers ({exc})")
+        return None
     if data.ndim != 2 or len(data) < 2 or not np.isfinite(data).all() or not (np.diff(data[:, 0]) > 0).all():
-        r.fail("geometry.profile", f"{path}: needs at least two rows with increasing y and finite numbers")
-        return None, None
+        r.fail(key, f"{path}: needs at least two rows with increasing y and finite numbers")
+        return None
     return tuple(data[:, 0] * scale[0]), tuple(data[:, 1] * scale[1])
 
 
@@ -546,7 +552,7 @@ def _expected(spec: Key) -> str:
 
 
 def _validate(raw: dict, problems: list, source: str, default_name: str, overrides: tuple) -> Optional[Case]:
-    r = _Reader(problems)
+    r = _Reader(problems, source)
     r.unknown(raw, set(SECTIONS), "")
     name = raw.get("name", default_name)
     if not isinstance(name, (str, int, float)) or isinstance(name, bool):
@@ -564,37 +570,14 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
         for k in geo:
             if k != "type" and k not in keys and geo[k] is not None:
                 r.fail(f"geometry.{k}", f"a {gtype} has no {k}; its keys are {', '.join(keys)}")
+        before = len(problems)
         vals = {k: r.key(geo, k, spec, f"geometry.{k}") for k, spec in keys.items()}
-        if all(v is not None for k, v in vals.items() if keys[k].default is REQUIRED):
-            if vals.get("block_length") is not None and vals["block_length"] < vals["length"] * (1 - 1e-9):
-                r.fail("geometry.block_length", f"the flat ({format_quantity(vals['block_length'], 'length')}) is "
-                                                f"shorter than the {gtype.split('_')[0]} "
-                                                f"({format_quantity(vals['length'], 'length')}): its edges would "
-                                                f"cut into the contact, which fretsim does not model; expected at "
-                                                f"least geometry.length")
-            elif gtype == "cylinder_on_flat":
-                geometry = CylinderOnFlat(vals["radius"], vals["length"], vals["block_length"])
-            elif gtype == "ball_on_flat":
-                geometry = BallOnFlat(vals["radius"])
-            elif gtype == "crossed_cylinders" and vals["sliding"] is not None:
-                geometry = CrossedCylinders(vals["radius"], vals["radius_stationary"] or vals["radius"],
-                                            vals["sliding"])
-            elif gtype == "roller_on_flat":
-                table = _read_profile(vals["profile"], source, r) if vals.get("profile") else (
-                    vals["profile_table"] if vals.get("profile_table") else (None, None))
-                if not (vals["crown_radius"] or vals["edge_radius"] or table[0] is not None):
-                    r.fail("geometry", "a roller_on_flat needs a profile: crown_radius, edge_radius (with "
-                                       "flat_length) or profile (a CSV file)")
-                elif vals["edge_radius"] and vals["flat_length"] is None:
-                    r.fail("geometry.flat_length", "an edge-rounded roller needs the length of its straight middle")
-                elif table[0] is not None or not vals.get("profile"):
-                    geometry = RollerOnFlat(vals["radius"], vals["length"], vals["block_length"],
-                                            vals["crown_radius"], vals["edge_radius"], vals["flat_length"], *table)
-            elif gtype == "tube_on_flat":
-                if vals["inner_radius"] >= vals["outer_radius"]:
-                    r.fail("geometry.inner_radius", "must be smaller than geometry.outer_radius")
-                else:
-                    geometry = TubeOnFlat(vals["outer_radius"], vals["inner_radius"], vals["length"])
+        if len(problems) == before and all(v is not None for k, v in vals.items() if keys[k].default is REQUIRED):
+            if "profile_table" in vals:  # a profile given inline or as a CSV file: one table either way
+                table = vals.pop("profile_table")
+                vals["profile"] = vals["profile"] or table
+            geometry = GEOMETRIES[gtype].from_case(
+                vals, lambda key, msg: r.fail(f"geometry.{key}" if key else "geometry", msg))
 
     mats = r.section(raw, "materials", {"moving", "stationary"})
     materials = {}

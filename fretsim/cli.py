@@ -4,16 +4,21 @@ Exit codes: 0 complete, 2 bad input (case, options, files), 3 a run that failed 
 4 a run stopped at a physical limit (a body worn through), 5 the results could not be written (disk full, I/O
 error; resume once there is room), 130 interrupted (resume with --resume).
 
-Each command imports what it needs when it runs, so `--help`, `summary` and `check` start quickly.
+Each command imports what it needs when it runs, so `--help`, `summary` and `check` start quickly.  Every command
+goes through one error boundary (:func:`_boundary`): a failure is one paragraph on stderr and an exit code, with
+the traceback only under ``--debug``.
 """
 from __future__ import annotations
 
+import functools
 import os
 import sys
 import traceback
 from pathlib import Path
 
 import click
+
+from fretsim.errors import InputError, ResultsFileError
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILED = 3
@@ -22,11 +27,36 @@ EXIT_IO = 5
 EXIT_INTERRUPTED = 130
 
 
-def _fail(message: str, code: int, debug: bool) -> None:
-    if debug:
-        traceback.print_exc()
-    click.echo(f"fretsim: {message}", err=True)
-    sys.exit(code)
+class Fail(Exception):
+    """A command's own failure: the paragraph to print and the exit code."""
+
+    def __init__(self, message: str, code: int = EXIT_BAD_INPUT):
+        super().__init__(message)
+        self.code = code
+
+
+def _boundary(command):
+    """The command line's one error boundary: bad input and unreadable files exit 2, a disk that refuses exit 5,
+    Ctrl-C exit 130, a command's own failure its code — each as one paragraph, a traceback only with --debug."""
+    @functools.wraps(command)
+    def guarded(*args, **kwargs):
+        try:
+            return command(*args, **kwargs)
+        except (Fail, InputError, ResultsFileError, KeyboardInterrupt, OSError) as exc:
+            if isinstance(exc, Fail):
+                code, message = exc.code, str(exc)
+            elif isinstance(exc, (InputError, ResultsFileError)):
+                code, message = EXIT_BAD_INPUT, str(exc)
+            elif isinstance(exc, KeyboardInterrupt):
+                code, message = EXIT_INTERRUPTED, "interrupted"
+            else:
+                where = f" {exc.filename}" if exc.filename else ""
+                code, message = EXIT_IO, f"cannot write{where}: {exc.strerror or exc}"
+            if kwargs.get("debug"):
+                traceback.print_exc()
+        click.echo(f"fretsim: {message}", err=True)
+        sys.exit(code)
+    return guarded
 
 
 @click.group(context_settings={"help_option_names": ["-h", "--help"]})
@@ -49,18 +79,18 @@ def main() -> None:
               help="Continue an interrupted run from its results file (no CASE_FILE then).")
 @click.option("--quiet", is_flag=True, help="No notes, no progress bar; the summary paragraph only.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
+@_boundary
 def run(case_file: Path | None, output: Path | None, overrides: tuple, overwrite: bool, resume_file: Path | None,
         quiet: bool, debug: bool) -> None:
     """Run CASE_FILE and write an HDF5 results file (or --resume one)."""
     import signal
 
-    from fretsim.api import CaseError, load_case, resume as resume_run, run as run_case
+    from fretsim.api import load_case, resume as resume_run, run as run_case
 
     if resume_file is not None and (case_file is not None or overrides or output is not None):
-        _fail("--resume takes the results file alone: the case, grid and settings are the ones stored in it",
-              EXIT_BAD_INPUT, debug)
+        raise Fail("--resume takes the results file alone: the case, grid and settings are the ones stored in it")
     if resume_file is None and case_file is None:
-        _fail("give a CASE_FILE to run, or --resume RESULTS_FILE", EXIT_BAD_INPUT, debug)
+        raise Fail("give a CASE_FILE to run, or --resume RESULTS_FILE")
     output = resume_file or output or Path(case_file.stem + ".h5")
     progress = _Progress(quiet or not sys.stderr.isatty())
 
@@ -81,16 +111,11 @@ def run(case_file: Path | None, output: Path | None, overrides: tuple, overwrite
         else:
             case = load_case(case_file, list(overrides))
             outcome = run_case(case, output, overwrite=overwrite, progress=progress.update, on_plan=_on_plan)
-    except CaseError as exc:
-        progress.stop()
-        _fail(str(exc), EXIT_BAD_INPUT, debug)
     except KeyboardInterrupt:
-        progress.stop()
-        _fail(f"interrupted; every accepted step so far is in {output} (status 'interrupted'); continue with "
-              f"`fretsim run --resume {output}`", EXIT_INTERRUPTED, debug)
-    except OSError as exc:
-        progress.stop()
-        _fail(f"cannot write {output}: {exc.strerror or exc}", EXIT_BAD_INPUT, debug)
+        raise Fail(f"interrupted; every accepted step so far is in {output} (status 'interrupted'); continue with "
+                   f"`fretsim run --resume {output}`", EXIT_INTERRUPTED) from None
+    except OSError as exc:  # before any step: the output's place cannot be written
+        raise Fail(f"cannot write {output}: {exc.strerror or exc}") from None
     finally:
         progress.stop()
         try:
@@ -98,13 +123,13 @@ def run(case_file: Path | None, output: Path | None, overrides: tuple, overwrite
         except (ValueError, TypeError):
             pass
     if outcome.status == "io_error":
-        _fail(f"could not write the results: {outcome.message}", EXIT_IO, debug)
+        raise Fail(f"could not write the results: {outcome.message}", EXIT_IO)
     if outcome.status == "stopped":
         click.echo(_paragraph(outcome))
-        _fail(f"stopped at a physical limit: {outcome.message}", EXIT_STOPPED, debug)
+        raise Fail(f"stopped at a physical limit: {outcome.message}", EXIT_STOPPED)
     if outcome.status != "complete":
-        _fail(f"run failed: {outcome.message}" + (f"; steps up to the failure are in {output} (status 'failed')"
-                                                  if outcome.written else ""), EXIT_FAILED, debug)
+        raise Fail(f"run failed: {outcome.message}" + (f"; steps up to the failure are in {output} (status 'failed')"
+                                                       if outcome.written else ""), EXIT_FAILED)
     click.echo(_paragraph(outcome))
 
 
@@ -181,16 +206,13 @@ def _paragraph(outcome) -> str:
 @click.argument("case_file", type=click.Path(path_type=Path))
 @click.option("--set", "overrides", multiple=True, metavar="KEY.PATH=VALUE", help="Override a case value.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
+@_boundary
 def check(case_file: Path, overrides: tuple, debug: bool) -> None:
     """Resolve CASE_FILE without running it: the filled case, the grid, every choice with its reason, the
     stability limit, an estimate of the solves and time, and every warning."""
-    from fretsim.api import CaseError, check as check_case, load_case
+    from fretsim.api import check as check_case, load_case
 
-    try:
-        case = load_case(case_file, list(overrides))
-        setup, filled, plan = check_case(case)
-    except CaseError as exc:
-        _fail(str(exc), EXIT_BAD_INPUT, debug)
+    setup, filled, plan = check_case(load_case(case_file, list(overrides)))
     g = setup.grid
     cells = f"{g.shape[1]} elements of {g.dx * 1e3:.4g} µm" if g.plane_strain else \
         f"{g.shape[1]} × {g.shape[0]} elements of {g.dx * 1e3:.4g} × {g.dy * 1e3:.4g} µm"
@@ -220,6 +242,7 @@ def _show(value) -> str:
 @click.option("--json", "as_json", is_flag=True, help="Machine-readable output (strict JSON; null for NaN).")
 @click.option("--csv", "as_csv", is_flag=True, help="One CSV row per file: inputs and summary figures.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
+@_boundary
 def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> None:
     """Print the summary figures of RESULTS_FILES (the /summary attributes), with the inputs of each run."""
     import json
@@ -230,9 +253,9 @@ def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> N
     for path in results_files:
         try:
             rows.append(summary_json(read_results(path)))
-        except ValueError as exc:
+        except ResultsFileError as exc:
             if len(results_files) == 1:
-                _fail(str(exc), EXIT_BAD_INPUT, debug)
+                raise
             bad.append(str(exc))
             rows.append({"path": str(path), "status": "unreadable", "message": str(exc)})
     if as_json:
@@ -275,6 +298,7 @@ def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> N
 @click.option("--jobs", type=click.IntRange(1, 2), default=None,
               help="Processes rendering the figures: 2 on a machine with 2 or more cores (default), else 1.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
+@_boundary
 def plot(results_file: Path, outdir: Path | None, fmt: str, dpi: int, log_cycles: bool, jobs: int | None,
          debug: bool) -> None:
     """Write figures of RESULTS_FILE: wear profiles across and along the contact, wear and pressure maps,
@@ -284,33 +308,24 @@ def plot(results_file: Path, outdir: Path | None, fmt: str, dpi: int, log_cycles
 
     if results_file.is_dir():
         from fretsim.results import read_sweep_table
-        try:
-            table = read_sweep_table(results_file)
-        except ValueError as exc:
-            _fail(str(exc), EXIT_BAD_INPUT, debug)
+        table = read_sweep_table(results_file)
         from fretsim.plotting import plot_sweep
-        for p in plot_sweep(table, outdir or results_file, fmt=fmt, dpi=dpi):
-            click.echo(str(p))
+        _write_and_list(lambda: plot_sweep(table, outdir or results_file, fmt=fmt, dpi=dpi), "figures")
         return
 
-    try:
-        res = read_results(results_file)
-    except ValueError as exc:
-        _fail(str(exc), EXIT_BAD_INPUT, debug)
+    res = read_results(results_file)
     from fretsim.plotting import plot_all
     jobs = jobs or (2 if (os.cpu_count() or 1) > 1 else 1)
     _write_and_list(lambda: plot_all(res, outdir or results_file.parent, fmt=fmt, dpi=dpi, log_cycles=log_cycles,
-                                     jobs=jobs), "figures", debug)
+                                     jobs=jobs), "figures")
 
 
-def _write_and_list(write, what: str, debug: bool) -> None:
-    """Run a writer of files and print their paths; bad data is exit 2, a refusing disk exit 5, no traceback."""
+def _write_and_list(write, what: str) -> None:
+    """Run a writer of files and print their paths; a refusing disk is exit 5, naming what could not be written."""
     try:
         paths = write()
-    except ValueError as exc:
-        _fail(str(exc), EXIT_BAD_INPUT, debug)
     except OSError as exc:
-        _fail(f"cannot write {what}: {exc.strerror or exc}", EXIT_IO, debug)
+        raise Fail(f"cannot write {what}: {exc.strerror or exc}", EXIT_IO) from None
     for p in paths:
         click.echo(str(p))
 
@@ -320,18 +335,21 @@ def _write_and_list(write, what: str, debug: bool) -> None:
 @click.option("--csv", "csv_dir", required=True, type=click.Path(file_okay=False, path_type=Path),
               help="Directory for history.csv, summary.csv, inputs.csv and fields.csv.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
+@_boundary
 def export(results_file: Path, csv_dir: Path, debug: bool) -> None:
     """Write RESULTS_FILE as CSV files for spreadsheets (units in the column names)."""
     from fretsim.export import export_csv
     from fretsim.results import read_results
 
-    _write_and_list(lambda: export_csv(read_results(results_file), csv_dir), str(csv_dir), debug)
+    res = read_results(results_file)
+    _write_and_list(lambda: export_csv(res, csv_dir), str(csv_dir))
 
 
 @main.command()
 @click.argument("kind", required=False, default="mccoll_185N")
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="Where to write the case (default: KIND.yaml in the current directory).")
+@_boundary
 def init(kind: str, output: Path | None) -> None:
     """Write a case to start from: a shipped case by name (e.g. mccoll_185N) or a commented template of a
     geometry (e.g. ball_on_flat).  `fretsim init --help` lists both."""
@@ -341,11 +359,11 @@ def init(kind: str, output: Path | None) -> None:
     if kind not in names:
         import difflib
         hint = difflib.get_close_matches(kind, names, n=1)
-        _fail(f"unknown case or geometry {kind!r}" + (f" (did you mean {hint[0]!r}?)" if hint else "")
-              + f"; choose one of {', '.join(names)}", EXIT_BAD_INPUT, False)
+        raise Fail(f"unknown case or geometry {kind!r}" + (f" (did you mean {hint[0]!r}?)" if hint else "")
+                   + f"; choose one of {', '.join(names)}")
     output = output or Path(f"{kind}.yaml")
     if output.exists():
-        _fail(f"{output} exists; choose another -o", EXIT_BAD_INPUT, False)
+        raise Fail(f"{output} exists; choose another -o")
     output.write_text(template_text(kind))
     click.echo(str(output))
 
@@ -357,24 +375,21 @@ def init(kind: str, output: Path | None) -> None:
 @click.option("--jobs", type=click.IntRange(0, 256), default=0, help="Parallel runs (default: the number of cores).")
 @click.option("--quick", is_flag=True, help="Line contacts in 2D and point contacts short: the check in a minute.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
+@_boundary
 def validate(cases: tuple, outdir: Path, jobs: int, quick: bool, debug: bool) -> None:
     """Run the published cases of the paper (default: every shipped case with expected values) and write a
     report against experiment, FEA and the paper.  Exit 0 when every case runs."""
-    from fretsim.case import CaseError
     from fretsim.validate import shipped_with_expected, validate as run_validation
 
     names = list(cases) or shipped_with_expected()
     unknown = [n for n in names if n not in shipped_with_expected()]
     if unknown:
-        _fail(f"no shipped case with expected values named {', '.join(unknown)}; choose from "
-              f"{', '.join(shipped_with_expected())}", EXIT_BAD_INPUT, debug)
-    try:
-        out = run_validation(names, outdir, jobs, quick)
-    except CaseError as exc:
-        _fail(str(exc), EXIT_BAD_INPUT, debug)
+        raise Fail(f"no shipped case with expected values named {', '.join(unknown)}; choose from "
+                   f"{', '.join(shipped_with_expected())}")
+    out = run_validation(names, outdir, jobs, quick)
     click.echo(f"{len(out['results'])} runs; report: {out['report']}")
     if not out["ok"]:
-        _fail("some cases did not complete: see the report", EXIT_FAILED, debug)
+        raise Fail("some cases did not complete: see the report", EXIT_FAILED)
 
 
 @main.command()
@@ -385,6 +400,7 @@ def validate(cases: tuple, outdir: Path, jobs: int, quick: bool, debug: bool) ->
 @click.option("--dask", "dask_address", metavar="tcp://HOST:PORT", help="Run the points on this Dask scheduler.")
 @click.option("--overwrite", is_flag=True, help="Run every point again, complete ones too.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
+@_boundary
 def sweep(sweep_file: Path, outdir: Path, jobs: int, dask_address: str | None, overwrite: bool, debug: bool) -> None:
     """Run every point of SWEEP_FILE (long-lived workers, or a Dask cluster) and write one table.
 
@@ -393,13 +409,9 @@ def sweep(sweep_file: Path, outdir: Path, jobs: int, dask_address: str | None, o
     import os
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # before numpy loads: one BLAS
         os.environ.setdefault(var, "1")                                        # thread per worker
-    from fretsim.case import CaseError
     from fretsim.sweep import load_sweep, run_sweep
 
-    try:
-        spec = load_sweep(sweep_file)
-    except CaseError as exc:
-        _fail(str(exc), EXIT_BAD_INPUT, debug)
+    spec = load_sweep(sweep_file)
     failures = {"n": 0}
     bar = None
     if sys.stderr.isatty():
@@ -414,18 +426,16 @@ def sweep(sweep_file: Path, outdir: Path, jobs: int, dask_address: str | None, o
             bar.update(1)
     try:
         out = run_sweep(spec, outdir, jobs, dask_address, overwrite, _progress)
-    except CaseError as exc:
-        _fail(str(exc), EXIT_BAD_INPUT, debug)
     except KeyboardInterrupt:
-        _fail(f"interrupted; the points done so far are in {outdir} and its table; run the same command again to "
-              f"continue", EXIT_INTERRUPTED, debug)
+        raise Fail(f"interrupted; the points done so far are in {outdir} and its table; run the same command again "
+                   f"to continue", EXIT_INTERRUPTED) from None
     finally:
         if bar is not None:
             bar.__exit__(None, None, None)
     counts = ", ".join(f"{n} {s}" for s, n in sorted(out.counts.items()))
     click.echo(f"{len(out.rows)} points: {counts}. Table: {out.table_csv}, {out.table_h5}")
     if not out.all_complete:
-        sys.exit(EXIT_FAILED)
+        raise Fail(f"not every point completed: see {out.table_csv}", EXIT_FAILED)
 
 
 @main.command("case-reference")

@@ -15,6 +15,9 @@ Every geometry knows
 * ``free_faces`` — the bodies that end in free faces across the contact (y = ±length/2), as (body, length)
   pairs: a cylinder's own ends, and the flat's when the case gives its length (paper §2.1, Fig. 2).
 
+``from_case(values, fail)`` builds one from the validated keys of its case section (``fretsim.case``), reporting
+any contradiction between them with ``fail(key, message)``; the reader knows no geometry by name.
+
 x is the sliding direction, y across it; the moving body is the one that slides.  All lengths in mm.
 """
 from __future__ import annotations
@@ -55,6 +58,12 @@ class Geometry:
 
     kind: ClassVar[str]
     line_length: Optional[float] = None
+
+    @classmethod
+    def from_case(cls, values: dict, fail) -> Optional["Geometry"]:
+        """The geometry of a case section's validated values (mm; absent options None), or None after reporting
+        with ``fail(key, message)`` why the values do not make one."""
+        return cls(**values)
 
     def separation(self, grid: Grid) -> np.ndarray:
         raise NotImplementedError
@@ -117,6 +126,16 @@ class CylinderOnFlat(Geometry):
     length: float
     block_length: Optional[float] = None  # the flat's length along y when it ends in free faces (mm)
 
+    @classmethod
+    def from_case(cls, values: dict, fail) -> Optional["CylinderOnFlat"]:
+        block, length = values.get("block_length"), values["length"]
+        if block is not None and block < length * (1 - 1e-9):
+            fail("block_length", f"the flat ({block!r} mm) is shorter than the {cls.kind.split('_')[0]} "
+                                 f"({length!r} mm): its edges would cut into the contact, which fretsim does not "
+                                 f"model; expected at least geometry.length")
+            return None
+        return cls(**values)
+
     @property
     def line_length(self) -> float:
         return self.length
@@ -177,6 +196,10 @@ class CrossedCylinders(Geometry):
     radius_stationary: float  # R₂
     sliding: str = "across"
 
+    @classmethod
+    def from_case(cls, values: dict, fail) -> "CrossedCylinders":
+        return cls(values["radius"], values.get("radius_stationary") or values["radius"], values["sliding"])
+
     @property
     def radii_xy(self) -> tuple[float, float]:
         r1, r2 = self.radius, self.radius_stationary
@@ -214,6 +237,13 @@ class TubeOnFlat(Geometry):
     outer_radius: float
     inner_radius: float
     length: float
+
+    @classmethod
+    def from_case(cls, values: dict, fail) -> Optional["TubeOnFlat"]:
+        if values["inner_radius"] >= values["outer_radius"]:
+            fail("inner_radius", "must be smaller than geometry.outer_radius")
+            return None
+        return cls(**values)
 
     @property
     def line_length(self) -> float:
@@ -262,6 +292,20 @@ class RollerOnFlat(CylinderOnFlat):
     flat_length: Optional[float] = None
     profile_y: Optional[tuple] = None  # mm
     profile_drop: Optional[tuple] = None  # mm
+
+    @classmethod
+    def from_case(cls, values: dict, fail) -> Optional["RollerOnFlat"]:
+        values = dict(values)
+        table = values.pop("profile", None) or (None, None)
+        if not (values["crown_radius"] or values["edge_radius"] or table[0] is not None):
+            fail("", "a roller_on_flat needs a profile: crown_radius, edge_radius (with flat_length) or profile (a "
+                     "CSV file)")
+            return None
+        if values["edge_radius"] and values["flat_length"] is None:
+            fail("flat_length", "an edge-rounded roller needs the length of its straight middle")
+            return None
+        cylinder = CylinderOnFlat.from_case({k: values[k] for k in ("radius", "length", "block_length")}, fail)
+        return None if cylinder is None else cls(**values, profile_y=table[0], profile_drop=table[1])
 
     # a cylinder's Hertz estimate, limits and scar estimate: the profile only relieves its ends
 

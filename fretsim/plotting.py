@@ -19,7 +19,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import MaxNLocator, ScalarFormatter  # noqa: E402
 
-from fretsim.results import Results, SweepTable  # noqa: E402
+from fretsim.results import Results, ResultsFileError, SweepTable  # noqa: E402
 
 STYLES = ["-", "--", "-.", ":", (0, (5, 1)), (0, (3, 1, 1, 1))]
 
@@ -81,7 +81,7 @@ def _cycles_label(n: int) -> str:
 def _builders(res: Results, log_cycles: bool) -> dict:
     """name → a function drawing that figure, for what the file holds (a contact-only run has no wear figures)."""
     if res.fields.get("cycle") is None or res.fields["cycle"].size == 0:
-        raise ValueError(f"{res.path} has no snapshot fields to plot (status {res.status})")
+        raise ResultsFileError(f"{res.path} has no snapshot fields to plot (status {res.status})")
     out = {"pressure_profiles": lambda: _pressure(res)}
     if (res.fields["cycle"] > 0).any():
         out["wear_profiles"] = lambda: _profiles(res)
@@ -315,7 +315,7 @@ def plot_sweep(table: SweepTable, outdir: str | Path, fmt: str = "png", dpi: int
     outdir.mkdir(parents=True, exist_ok=True)
     axes = list(table.axes)
     if not axes:
-        raise ValueError(f"{table.path}: the sweep has no axes (a list of points): nothing to draw curves over")
+        raise ResultsFileError(f"{table.path}: the sweep has no axes (a list of points): nothing to draw curves over")
     paths = []
     for axis in axes:
         fig, ax_list = plt.subplots(1, len(SWEEP_OUTPUTS), figsize=(4.2 * len(SWEEP_OUTPUTS), 3.8), squeeze=False)

@@ -51,6 +51,7 @@ import h5py
 import numpy as np
 
 from fretsim import __version__
+from fretsim.errors import ResultsFileError
 
 FORMAT_VERSION = "1.2"
 READABLE_FORMATS = ("1.1", "1.2")
@@ -448,7 +449,7 @@ class Results:
         return fields, history
 
 
-class _Damaged(ValueError):
+class _Damaged(ResultsFileError):
     pass
 
 
@@ -463,13 +464,13 @@ def _regular_file(path: str | Path) -> None:
     try:
         st = os.stat(path)
     except FileNotFoundError:
-        raise ValueError(f"{path}: no such results file") from None
+        raise ResultsFileError(f"{path}: no such results file") from None
     except OSError as exc:
-        raise ValueError(f"{path}: cannot read it ({exc.strerror})") from None
+        raise ResultsFileError(f"{path}: cannot read it ({exc.strerror})") from None
     if stat.S_ISDIR(st.st_mode):
-        raise ValueError(f"{path}: is a directory, not a results file")
+        raise ResultsFileError(f"{path}: is a directory, not a results file")
     if not stat.S_ISREG(st.st_mode):
-        raise ValueError(f"{path}: not a regular file (a FIFO, device or socket); expected an HDF5 results file")
+        raise ResultsFileError(f"{path}: not a regular file (a FIFO, device or socket); expected an HDF5 results file")
 
 
 def _dataset(f, path: str, ndim: Optional[int] = None, numeric: bool = True, shape: Optional[tuple] = None):
@@ -520,15 +521,15 @@ def read_results(path: str | Path, for_resume: bool = False) -> Results:
         with h5py.File(path, "r") as f:
             return _read(f, str(path), for_resume)
     except _Damaged as exc:
-        raise ValueError(f"{path}: damaged or not a fretsim results file: {exc}") from None
+        raise ResultsFileError(f"{path}: damaged or not a fretsim results file: {exc}") from None
     except (OSError, RuntimeError, KeyError, TypeError, IndexError, AttributeError, UnicodeDecodeError) as exc:
-        raise ValueError(f"{path}: not a readable fretsim results file ({type(exc).__name__}: "
+        raise ResultsFileError(f"{path}: not a readable fretsim results file ({type(exc).__name__}: "
                          f"{str(exc)[:200]})") from None
 
 
 def _read(f, path: str, for_resume: bool) -> Results:
     if "format_version" not in f.attrs:
-        raise ValueError(f"{path} is an HDF5 file but not a fretsim results file (no format_version)")
+        raise ResultsFileError(f"{path} is an HDF5 file but not a fretsim results file (no format_version)")
     version = _text(f.attrs["format_version"])
     if version not in READABLE_FORMATS:
         raise _Damaged(f"format_version {version!r} is not one this fretsim reads ({', '.join(READABLE_FORMATS)})")
@@ -687,5 +688,5 @@ def read_sweep_table(directory: str | Path) -> SweepTable:
         with open(directory / "table.csv", newline="") as fh:
             rows = list(csv.DictReader(fh))
     except (OSError, KeyError, ValueError, TypeError) as exc:
-        raise ValueError(f"{directory}: not a sweep's directory with a readable table ({exc})") from None
+        raise ResultsFileError(f"{directory}: not a sweep's directory with a readable table ({exc})") from None
     return SweepTable(str(directory), axes, units, rows)

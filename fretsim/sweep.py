@@ -205,7 +205,7 @@ def run_point(task: tuple) -> dict:
     name, base_text, base_source, overrides, output, mode = task
     if _STOPPING:
         return {"name": name, "status": "not run", "message": "the sweep was stopped first"}
-    from fretsim.api import resume, run
+    from fretsim.runner import resume, run
     try:
         _IN_POINT = True
         if mode == "resume":
@@ -312,7 +312,7 @@ def _run_local(tasks: list, jobs: int, progress) -> list:
     # numpy, scipy and h5py, a second or two each); the CLI pins BLAS to one thread before numpy loads
     ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
     if ctx.get_start_method() == "fork":
-        import fretsim.api  # noqa: F401 - imported once here (scipy's FFT and interpolation, ~1.5 s), not per worker
+        import fretsim.runner  # noqa: F401 - imported once here (scipy's FFT and interpolation, ~1.5 s), not per worker
     pool = ProcessPoolExecutor(max_workers=max(1, min(jobs, len(tasks))), mp_context=ctx, initializer=_init_worker)
     try:
         futures = [pool.submit(run_point, t) for t in tasks]

@@ -113,7 +113,7 @@ def _contact_half_width(grid, p: np.ndarray, line: bool) -> float:
 def run_one(args: tuple) -> dict:
     """Run one case (in a worker process): its summary, a few derived figures, and the time."""
     name, overrides = args
-    from fretsim.api import run
+    from fretsim.runner import run
     case = load_case(CASES / f"{name}.yaml", list(overrides))
     t = time.perf_counter()
     try:

@@ -21,6 +21,21 @@ from fretsim.solvers.result import ContactResult, complementarity_residual
 
 def solve_active_set(compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] = None,
                      tol: float = 1e-10, max_iter: Optional[int] = None) -> ContactResult:
+    """Normal contact by a dense active-set method (Kalker): an independent, exact check on small grids.
+
+    Parameters
+    ----------
+    compliance : an operator with ``dense()`` (at most ``DENSE_LIMIT`` elements).
+    gap : the initial separation ε (mm); +inf where no contact is possible.
+    load : Σ p·A (N; N/mm in 2D).
+    p0 : a warm start: its contact set is the first guess of the active set.
+    tol : the penetration allowed outside the contact set, relative to the spread of the displacement.
+    max_iter : sweeps of the active set allowed (default 200).
+
+    Returns
+    -------
+    ContactResult : with ``success`` False and a message if the set kept changing or a system was singular.
+    """
     shape = gap.shape
     idx = np.flatnonzero(np.isfinite(gap).ravel())
     try:

@@ -39,6 +39,24 @@ def _preconditioner(compliance):
 
 def solve_cg(compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] = None,
              tol: float = 1e-10, max_iter: Optional[int] = None, precondition: bool = True) -> ContactResult:
+    """Normal contact by preconditioned constrained conjugate gradient (Polonsky & Keer 1999), FFT-applied.
+
+    Parameters
+    ----------
+    compliance : an operator of :mod:`fretsim.compliance` (u = C p, mm per MPa); its ``convolution`` part, if
+        any, preconditions the iteration.
+    gap : the initial separation ε (mm), shape of the grid; +inf where no contact is possible.
+    load : Σ p·A to reach (N; N/mm in 2D).
+    p0 : a warm start (MPa), clipped to p ≥ 0 and rescaled to the load; None starts near the closest points.
+    tol : the relative (L1) pressure change of an iteration below which it stops, the gap then complementary.
+    max_iter : iterations allowed (default from the grid size).
+    precondition : False gives the plain Polonsky–Keer step (for comparisons).
+
+    Returns
+    -------
+    ContactResult : pressure, approach α, contact set, iterations, ``success`` and a message; never raises on
+        non-convergence (the caller decides).
+    """
     area = compliance.grid.area
     total = load / area  # required Σp
     allowed = np.isfinite(gap)

@@ -40,6 +40,21 @@ from fretsim.solvers.result import ContactResult, complementarity_residual
 
 def solve_msm(compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] = None,
               tol: float = 1e-10, max_iter: Optional[int] = None) -> ContactResult:
+    """Normal contact by the paper's Modified Simplex Method (Eqs. 7–8): an exact vertex of the LP, dense.
+
+    Parameters
+    ----------
+    compliance : an operator with ``dense()`` (at most ``DENSE_LIMIT`` elements); its matrix is C of Eq. 5.
+    gap : the initial separation ε (mm); +inf where no contact is possible (those elements are left out).
+    load : Σ p·A (N; N/mm in 2D).
+    p0 : ignored (the simplex starts from its own feasible basis).
+    tol : ignored (the solution is exact to round-off when the artificial variables reach zero).
+    max_iter : pivots allowed (default 4n + 10).
+
+    Returns
+    -------
+    ContactResult : with ``success`` False and a message if the pivots ran out or the matrix was too large.
+    """
     shape = gap.shape
     idx = np.flatnonzero(np.isfinite(gap).ravel())
     try:
