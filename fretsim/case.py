@@ -20,7 +20,7 @@ import numpy as np
 
 from fretsim.errors import InputError
 from fretsim.geometry import GEOMETRIES, Geometry
-from fretsim.units import UnitError, format_quantity, parse_quantity
+from fretsim.units import UNITS, UnitError, format_quantity, parse_quantity
 from fretsim.yamlread import YamlProblem, excerpt, loads, read_text
 
 SCHEMES = ("bdf2", "implicit", "linear", "adaptive")
@@ -28,6 +28,9 @@ SCHEMES = ("bdf2", "implicit", "linear", "adaptive")
 PRESETS = {"paper": {"scheme": "adaptive", "eta": 0.55, "max": 600, "linear": 55}}
 DIMENSIONS = ("2d", "3d", "auto")
 GAP_MODELS = ("auto", "mid_stroke", "stroke_average")
+SLIP_MODELS = ("auto", "uniform", "coulomb")
+STROKE_MODELS = ("auto", "mid_stroke", "resolved")
+WEAR_LAWS = ("archard", "energy")
 CORRECTIONS = ("ring_bending", "free_faces")
 MAX_CYCLES = 10**10
 LENGTH_RANGE = (1e-3, 1e4, "1 µm to 10 m")
@@ -101,9 +104,13 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "youngs_modulus": Key("pressure", "Young's modulus E", REQUIRED, plausible=(1.0, 1e7, "1 MPa to 10 TPa"),
                               example="200 GPa"),
         "poissons_ratio": Key("number", "Poisson's ratio ν", REQUIRED, lo=-1.0, hi=0.5, example="0.3"),
-        "wear_coefficient": Key("wear_coefficient", "Archard wear coefficient k (Eqs. 14–16; includes hardness)",
-                                REQUIRED, plausible=(0.0, 1e-3, "0 to 1e-3 1/MPa"), positive=False,
-                                example="2.0e-8 1/MPa")},
+        "wear_coefficient": Key("wear_coefficient", "Archard wear coefficient k (Eqs. 14–16; includes hardness); "
+                                                    "required with model.wear_law archard", None,
+                                plausible=(0.0, 1e-3, "0 to 1e-3 1/MPa"), positive=False, example="2.0e-8 1/MPa"),
+        "energy_wear_coefficient": Key("energy_wear_coefficient", "energy wear coefficient α (Fouvry): worn volume "
+                                                                  "per dissipated energy, dh = α·|q|·|ds|; "
+                                                                  "required with model.wear_law energy", None,
+                                       plausible=(0.0, 1.0, "0 to 1000 mm3/J"), positive=False)},
     "loading": {
         "normal_load": Key("force", "normal load P (total, both in 2D and 3D)", REQUIRED,
                            plausible=(1e-6, 1e7, "1 µN to 10 MN"), example="185 N"),
@@ -111,9 +118,14 @@ SCHEMA: dict[str, dict[str, Key]] = {
                       plausible=(1e-6, 10.0, "1 nm to 10 mm"), example="25 um"),
         "cycles": Key("integer", "fretting cycles N (0 solves the contact alone)", REQUIRED, lo=0, hi=MAX_CYCLES,
                       example="18000"),
-        "friction_coefficient": Key("number", "friction coefficient μ: checks gross slip against Mindlin's "
-                                              "partial-slip limit (not used in the wear law)", None, lo=0.0,
-                                    hi=10.0)},
+        "friction_coefficient": Key("number", "friction coefficient μ (Coulomb): the shear traction |q| ≤ μp of "
+                                              "model.slip coulomb, the regime (partial or gross slip) and, for "
+                                              "the uniform model, the energy law and the reported energy", None,
+                                    lo=0.0, hi=10.0),
+        "tangential_stiffness": Key("stiffness", "the rig's tangential stiffness: it takes Q/k of the stroke, the "
+                                                 "contact the rest (as in fretting rigs and FE models of them); "
+                                                 "omitted: a rigid rig", None,
+                                    plausible=(1e-3, 1e12, "1 N/m to 1e12 N/mm"))},
     "model": {
         "dimension": Key("choice", "2d (line contact per unit length), 3d, or auto: the cheapest within "
                                    "model.accuracy", "auto", choices=DIMENSIONS, any_case=True),
@@ -124,7 +136,20 @@ SCHEMA: dict[str, dict[str, Key]] = {
                                           "(tubes, Eq. 23) and free_faces (3d: bodies that end across the "
                                           "contact, paper §2.1)", "auto"),
         "accuracy": Key("fraction", "largest difference from the full model accepted when `auto` simplifies it",
-                        0.01, lo=1e-4, hi=0.5)},
+                        0.01, lo=1e-4, hi=0.5),
+        "slip": Key("choice", "the fretting cycle: uniform (the paper's gross slip, 4δ everywhere), coulomb "
+                              "(Coulomb friction through the cycle: partial and gross slip, the local slip in the "
+                              "wear law), or auto: coulomb where uniform slip is not within model.accuracy of it",
+                    "auto", choices=SLIP_MODELS),
+        "stroke": Key("choice", "the normal contact at mid-stroke only (mid_stroke, the paper) or at each increment "
+                                "of the cycle with the moving body where it is over the worn flat (resolved); "
+                                "auto: mid_stroke for uniform slip, resolved for coulomb", "auto",
+                      choices=STROKE_MODELS),
+        "wear_law": Key("choice", "archard (dh = k·p·|ds|) or energy (dh = α·|q|·|ds|, Fouvry; needs "
+                                  "materials.*.energy_wear_coefficient and loading.friction_coefficient)",
+                        "archard", choices=WEAR_LAWS),
+        "increments": Key("integer", "increments per half-stroke of the cycle (coulomb; odd: one is centred on "
+                                     "mid-stroke)", 9, lo=1, hi=1001)},
     "solver": {
         "method": Key("choice", "contact solver: cg (FFT, Polonsky–Keer), msm (the paper's simplex, dense), "
                                 "active_set (dense)", "cg", choices=("cg", "msm", "active_set")),
@@ -176,7 +201,8 @@ class CaseError(InputError):
 class Material:
     youngs_modulus: float  # MPa
     poissons_ratio: float
-    wear_coefficient: float  # 1/MPa
+    wear_coefficient: Optional[float]  # 1/MPa (Archard's k)
+    energy_wear_coefficient: Optional[float] = None  # mm³/(N·mm) = 1/MPa (α)
 
 
 @dataclass(frozen=True)
@@ -189,10 +215,15 @@ class Case:
     stroke: float  # mm, the amplitude δ (sliding distance per cycle 4δ)
     cycles: int
     friction_coefficient: Optional[float] = None
+    tangential_stiffness: Optional[float] = None  # N/mm, the rig's
     dimension: str = "auto"
     gap_model: str = "auto"
     corrections: object = "auto"  # "auto", "none" or a tuple of CORRECTIONS
     accuracy: float = 0.01
+    slip: str = "auto"
+    stroke_model: str = "auto"
+    wear_law: str = "archard"
+    increments: int = 9
     solver: str = "cg"
     tolerance: float = 1e-5  # contact solver
     scheme: str = "bdf2"
@@ -212,6 +243,14 @@ class Case:
     @property
     def plane_strain(self) -> bool:
         return self.dimension == "2d"
+
+    def wear_coefficients(self) -> tuple[float, float]:
+        """(moving, stationary) coefficients of p·ds in gross slip: Archard's k, or α·μ for the energy law
+        (|q| = μp wherever a point slips)."""
+        if self.wear_law == "energy":
+            mu = self.friction_coefficient
+            return self.moving.energy_wear_coefficient * mu, self.stationary.energy_wear_coefficient * mu
+        return self.moving.wear_coefficient, self.stationary.wear_coefficient
 
     def with_choices(self, **kw: Any) -> "Case":
         return replace(self, **kw)
@@ -234,9 +273,12 @@ class Case:
             geometry[key] = format_quantity(value, spec.kind) if spec.kind in ("length",) else value
 
         def mat(m: Material) -> dict:
-            return {"youngs_modulus": format_quantity(m.youngs_modulus, "pressure"),
-                    "poissons_ratio": m.poissons_ratio,
-                    "wear_coefficient": format_quantity(m.wear_coefficient, "wear_coefficient")}
+            out = {"youngs_modulus": format_quantity(m.youngs_modulus, "pressure"), "poissons_ratio": m.poissons_ratio}
+            if m.wear_coefficient is not None:
+                out["wear_coefficient"] = format_quantity(m.wear_coefficient, "wear_coefficient")
+            if m.energy_wear_coefficient is not None:
+                out["energy_wear_coefficient"] = format_quantity(m.energy_wear_coefficient, "energy_wear_coefficient")
+            return out
 
         grid: dict = {}
         if self.domain is not None:
@@ -249,6 +291,8 @@ class Case:
                    "stroke": format_quantity(self.stroke, "length"), "cycles": self.cycles}
         if self.friction_coefficient is not None:
             loading["friction_coefficient"] = self.friction_coefficient
+        if self.tangential_stiffness is not None:
+            loading["tangential_stiffness"] = format_quantity(self.tangential_stiffness, "stiffness")
         jumping = {"scheme": self.scheme, "tolerance": self.step_tolerance,
                    "linear": self.linear_jump if self.linear_jump is not None else "auto",
                    "eta": self.eta, "max": self.max_jump if self.max_jump is not None else "auto"}
@@ -261,7 +305,8 @@ class Case:
             "loading": loading,
             "model": {"dimension": self.dimension, "gap": self.gap_model,
                       "corrections": list(self.corrections) if isinstance(self.corrections, tuple) else self.corrections,
-                      "accuracy": self.accuracy},
+                      "accuracy": self.accuracy, "slip": self.slip, "stroke": self.stroke_model,
+                      "wear_law": self.wear_law, "increments": self.increments},
             "solver": {"method": self.solver, "tolerance": self.tolerance},
             "jumping": jumping,
             "grid": grid,
@@ -377,7 +422,7 @@ class _Reader:
 
     def value(self, value: Any, spec: Key, path: str) -> Any:
         kind = spec.kind
-        if kind in ("length", "force", "pressure", "wear_coefficient"):
+        if kind in UNITS:
             return self.quantity(value, spec, path)
         if kind == "number":
             return self.number(value, spec, path)
@@ -534,9 +579,14 @@ def _read_profile(name, source: str, r: "_Reader", key: str = "geometry.profile"
     return tuple(data[:, 0] * scale[0]), tuple(data[:, 1] * scale[1])
 
 
+def _example(kind: str) -> str:
+    from fretsim.units import example
+    return example(kind)
+
+
 def _expected(spec: Key) -> str:
     kind = spec.kind
-    if kind in ("length", "force", "pressure", "wear_coefficient"):
+    if kind in UNITS:
         from fretsim.units import example
         return f"a {kind.replace('_', ' ')} with its unit, e.g. '{example(kind)}'"
     if kind == "choice":
@@ -587,12 +637,13 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
         m = mats.get(body)
         path = f"materials.{body}"
         if not isinstance(m, dict):
-            r.fail(path, "missing; expected a mapping with youngs_modulus, poissons_ratio, wear_coefficient"
-                   if m is None else f"expected a mapping, got {excerpt(m)}")
+            r.fail(path, "missing; expected a mapping with youngs_modulus, poissons_ratio, wear_coefficient (or "
+                         "energy_wear_coefficient)" if m is None else f"expected a mapping, got {excerpt(m)}")
             continue
         r.unknown(m, SCHEMA["material"], path)
+        before = len(problems)
         vals = [r.key(m, k, spec, f"{path}.{k}") for k, spec in SCHEMA["material"].items()]
-        if None not in vals:
+        if len(problems) == before:
             materials[body] = Material(*vals)
 
     def read(section: str, required: bool = False) -> dict:
@@ -625,6 +676,21 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
     if geometry is not None and dimension == "2d" and not geometry.has_2d:
         r.fail("model.dimension", f"a {geometry.kind} is a point contact: it needs 3d (2d is a line contact)")
 
+    law, slip, mu = model.get("wear_law"), model.get("slip"), load.get("friction_coefficient")
+    key = "wear_coefficient" if law == "archard" else "energy_wear_coefficient"
+    for body, m in materials.items():
+        if getattr(m, key) is None:
+            r.fail(f"materials.{body}.{key}", f"missing; model.wear_law {law} needs it, e.g. "
+                                              f"'{_example(key)}'")
+    if mu is None and (slip == "coulomb" or law == "energy"):
+        why = "model.slip coulomb" if slip == "coulomb" else "model.wear_law energy (dh = α·|q|·|ds|, |q| = μp)"
+        r.fail("loading.friction_coefficient", f"missing; {why} needs it, e.g. 0.9")
+    if model.get("increments") is not None and model["increments"] % 2 == 0:
+        r.fail("model.increments", f"{model['increments']} is even; expected an odd number, so that one increment "
+                                   f"is centred on mid-stroke (e.g. {model['increments'] + 1})")
+    if mu == 0 and slip == "coulomb":
+        r.fail("loading.friction_coefficient", "0 with model.slip coulomb: without friction nothing resists "
+                                               "the stroke and nothing wears by it; give μ > 0")
     domain, elements, coarse = grid.get("domain"), grid.get("elements"), grid.get("coarse_element")
     stroke = load.get("stroke")
     if domain is not None and stroke is not None and stroke >= domain[0] / 2:
@@ -636,8 +702,11 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
         return None
     return Case(name=name, geometry=geometry, moving=materials["moving"], stationary=materials["stationary"],
                 normal_load=load["normal_load"], stroke=stroke, cycles=load["cycles"],
-                friction_coefficient=load.get("friction_coefficient"), dimension=dimension,
+                friction_coefficient=load.get("friction_coefficient"),
+                tangential_stiffness=load.get("tangential_stiffness"), dimension=dimension,
                 gap_model=model["gap"], corrections=model["corrections"], accuracy=model["accuracy"],
+                slip=model["slip"], stroke_model=model["stroke"], wear_law=model["wear_law"],
+                increments=model["increments"],
                 solver=solver["method"],
                 tolerance=solver["tolerance"], scheme=scheme, step_tolerance=jumping["tolerance"],
                 linear_jump=jumping.get("linear") if scheme in ("linear", "adaptive") else jumping.get("linear"),

@@ -16,12 +16,14 @@ import numpy as np
 
 from fretsim.case import PRESETS, Case, CaseError
 from fretsim.compliance import HalfSpace, add
-from fretsim.cycle import UniformCycle
+from fretsim.cycle import CoulombCycle, UniformCycle
+from fretsim.cycle.coulomb import gross_slip_stroke
 from fretsim.grid import Grid
 from fretsim.loading import Loading, single
 from fretsim.reference import effective_modulus
 from fretsim.simulate import Setup, SimulationError
 from fretsim.sizing import Sizing, auto_grid
+from fretsim.solvers import solve
 from fretsim.stability import Spectrum, default_linear_jump, wear_spectrum
 from fretsim.wear import stroke_reach, stroke_symbol, wear_operator
 
@@ -120,7 +122,7 @@ def _full_corrections(case: Case, dimension: str):
 def _dimension_proxy(case: Case, e_star: float) -> tuple[float, str]:
     from fretsim.simulate import simulate, summarize
     g = case.geometry
-    k = case.moving.wear_coefficient + case.stationary.wear_coefficient
+    k = sum(case.wear_coefficients())
     sizing = auto_grid(g, False, case.normal_load, case.stroke, case.cycles, k, e_star)
     nx = max(21, (sizing.elements[0] // 2) | 1)
     keys = (("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "centre_wear_depth_stationary_um",
@@ -163,7 +165,7 @@ def choose_grid(case: Case, plane: bool, sizing: Sizing) -> tuple[Choice, Choice
 
 def choose_gap_model(case: Case, grid: Grid) -> Choice:
     """mid_stroke (the paper) where it is stable, stroke_average where the paper's model itself is not."""
-    k_m, k_s = case.moving.wear_coefficient, case.stationary.wear_coefficient
+    k_m, k_s = case.wear_coefficients()
     b_min = float(stroke_symbol(grid.dx, case.stroke, np.linspace(0.01 * np.pi, np.pi, 400)).min())
     stable = k_m + k_s * min(b_min, 0.0) >= 0
     if case.gap_model != "auto":
@@ -252,7 +254,7 @@ def _proxy_difference(case: Case, corrections: tuple, dimension: str = "2d") -> 
         keys = keys + (("centre_wear_depth_stationary_um",) if case.cycles else ())
         e_star = effective_modulus(case.moving.youngs_modulus, case.moving.poissons_ratio,
                                    case.stationary.youngs_modulus, case.stationary.poissons_ratio)
-        k = case.moving.wear_coefficient + case.stationary.wear_coefficient
+        k = sum(case.wear_coefficients())
         sizing = auto_grid(case.geometry, False, case.normal_load, case.stroke, case.cycles, k, e_star)
         # all the rows: the faces act on the end rows, which 15 coarse rows widen and blunt (1.0 % for 1.4 %)
         grid = {"domain": sizing.domain, "elements": (max(21, (sizing.elements[0] // 2) | 1), sizing.elements[1])}
@@ -356,7 +358,7 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
     g = case.geometry
     e_star = effective_modulus(case.moving.youngs_modulus, case.moving.poissons_ratio,
                                case.stationary.youngs_modulus, case.stationary.poissons_ratio)
-    k_m, k_s = case.moving.wear_coefficient, case.stationary.wear_coefficient
+    k_m, k_s = case.wear_coefficients()
     problems: list = []
     hertz = g.hertz(case.normal_load, e_star)
     if case.stroke > MAX_STROKE_OVER_CONTACT * hertz.half_width_x:
@@ -449,7 +451,25 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
     if coarse is not None:
         coarse_op = operator(coarse)
     solve_op = coarse_op if coarse_op is not None else compliance
-    spectrum = wear_spectrum(solve_op, case.stroke, k_m, k_s, gap_model)
+    load = case.normal_load / g.line_length if plane else case.normal_load
+    volume_factor = g.line_length if plane else 1.0
+    tangential = transition = None
+    if case.friction_coefficient is not None:
+        tangential = tangential_operator(case, grid)
+        transition = gross_slip_stroke(tangential, solve(compliance, g.separation(grid), load,
+                                                         tol=case.tolerance).pressure, case.friction_coefficient)
+    slip = plan.add(choose_slip(case, transition))
+    stroke_model = plan.add(choose_stroke(case, slip, grid))
+    if slip == "coulomb" or stroke_model == "resolved":
+        _check_cycle_model(case, coarse, corrections, plan)
+        if stroke_model == "resolved":
+            plan.add(Choice("model.gap", case.gap_model, "not used: the stroke is resolved, each position sees the "
+                                                         "flat's wear under it", case.gap_model != "auto"))
+            plan.warnings.append("model.stroke resolved: the worn profiles develop kinks where the contact's edges "
+                                 "turn at the stroke's ends, with pressure peaks there that grow as the grid is "
+                                 "refined (the depths and widths settle; the peak pressure does not), and the "
+                                 "depths move with the step size by a few per cent (README: the resolved stroke)")
+    spectrum = wear_spectrum(solve_op, case.stroke, k_m, k_s, "resolved" if stroke_model == "resolved" else gap_model)
     limit = spectrum.limit
     _check_model_growth(case, gap_model, spectrum, plan)
     scheme = plan.add(choose_scheme(case))
@@ -478,18 +498,25 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
     if beyond:
         plan.warnings.append(f"snapshots {list(beyond)} lie beyond the run's {case.cycles} cycles and are skipped")
     snapshots = tuple(sorted({s for s in snapshots if s <= case.cycles} | {case.cycles}))
-    warn_gross_slip(case, e_star, hertz, plan)
     loading = loading_of(case)
-    load = case.normal_load / g.line_length if plane else case.normal_load
-    model = UniformCycle(grid=grid, wear_op=wear_operator(solve_op.grid, case.stroke, k_m, k_s, gap_model),
-                         stroke=case.stroke, load=load, total_load=case.normal_load, k_moving=k_m, k_stationary=k_s,
-                         gap_model=gap_model, friction_coefficient=case.friction_coefficient)
+    if slip == "uniform" and stroke_model == "mid_stroke":
+        model = UniformCycle(grid=grid, wear_op=wear_operator(solve_op.grid, case.stroke, k_m, k_s, gap_model),
+                             stroke=case.stroke, load=load, total_load=case.normal_load, k_moving=k_m,
+                             k_stationary=k_s, gap_model=gap_model, friction_coefficient=case.friction_coefficient)
+    else:
+        law_m, law_s = ((case.moving.wear_coefficient, case.stationary.wear_coefficient) if case.wear_law == "archard"
+                        else (case.moving.energy_wear_coefficient, case.stationary.energy_wear_coefficient))
+        model = CoulombCycle(grid=grid, compliance=compliance, tangential=tangential, stroke=case.stroke, load=load,
+                             total_load=case.normal_load, friction_coefficient=case.friction_coefficient,
+                             k_moving=law_m, k_stationary=law_s, law=case.wear_law, slip=slip,
+                             stroke_model=stroke_model, gap_model=gap_model, increments=case.increments,
+                             volume_factor=volume_factor)
     reach = stroke_reach(grid.dx, case.stroke)
-    band = (2 * reach if gap_model == "stroke_average" else reach) + 1  # the flat's wear, as the solve sees it
+    band = (2 * reach if gap_model == "stroke_average" and stroke_model == "mid_stroke" else reach) + 1
     setup = Setup(grid=grid, compliance=compliance, gap=g.separation(grid), loading=loading, cycle=model, band=band,
                   scheme=scheme, linear_jump=jump, stability_limit=limit, method=case.solver,
                   tolerance=case.tolerance, snapshots=snapshots,
-                  volume_factor=g.line_length if plane else 1.0, limits=g.limits, y_edges_free=g.y_edges_free,
+                  volume_factor=volume_factor, limits=g.limits, y_edges_free=g.y_edges_free,
                   eta=case.eta, max_jump=max_jump, step_tolerance=case.step_tolerance, implicit_cap=cap, coarse=coarse,
                   coarse_compliance=coarse_op, coarse_gap=coarse_gap, per_cycle=per_cycle,
                   notes=tuple(f"{c.key} = {_show(c.value)}: {c.reason}" for c in plan.choices if not c.given)
@@ -497,13 +524,97 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
     filled = case.with_choices(dimension=dimension, corrections=corrections or "none",
                                domain=tuple(domain[:1] if plane else domain[:2]),
                                elements=(nx,) if plane else (nx, ny), gap_model=gap_model, scheme=scheme,
+                               slip=slip, stroke_model=stroke_model,
                                linear_jump=jump, max_jump=max_jump, snapshots=snapshots)
     return setup, filled, plan
 
 
 def loading_of(case: Case) -> Loading:
     """The case's loading: one block today."""
-    return single(case.normal_load, case.stroke, case.cycles, case.friction_coefficient)
+    return single(case.normal_load, case.stroke, case.cycles, case.friction_coefficient, case.tangential_stiffness)
+
+
+def tangential_operator(case: Case, grid: Grid):
+    """Both bodies' tangential compliance on the grid, the 2D datum and the rig's compliance
+    (:mod:`fretsim.compliance.tangential`)."""
+    from fretsim.compliance.tangential import Tangential
+    plane = grid.plane_strain
+    volume_factor = case.geometry.line_length if plane else 1.0
+    rig = grid.area * volume_factor / case.tangential_stiffness if case.tangential_stiffness else 0.0
+    bodies = [(m.youngs_modulus, m.poissons_ratio) for m in (case.moving, case.stationary)]
+    return Tangential(grid, bodies, case.geometry.line_length if plane else None, rig)
+
+
+def choose_slip(case: Case, transition: Optional[float]) -> Choice:
+    """uniform (the paper's gross slip) or coulomb (friction resolved through the cycle).
+
+    The regime follows from the unworn contact: gross slip needs the stroke to exceed δ_t, the rig displacement
+    at which the last point starts to slide (δ_t = max K·μp: every point then carries μp; with the rig's 1/k
+    included).  Below it the contact partly sticks and uniform slip is refused.  Above it every point still
+    slides less than the rig by its elastic tangential displacement, at most δ_t: uniform slip overestimates
+    the slip, and so the wear, by up to δ_t/δ; auto keeps uniform only where that is within model.accuracy.
+    """
+    mu = case.friction_coefficient
+    if transition is not None and case.slip in ("uniform", "auto") and case.stroke <= transition:
+        if case.slip == "uniform":
+            raise CaseError(case.source, [("model.slip", f"uniform slip is refused here: the stroke "
+                                                         f"{case.stroke * 1e3:.4g} µm is within the partial-slip "
+                                                         f"limit δ_t = {transition * 1e3:.4g} µm for μ = {mu:g}, so "
+                                                         f"the contact partly sticks and uniform slip (4δ at every "
+                                                         f"point) would overestimate the wear; use model.slip: "
+                                                         f"coulomb (or auto)")])
+        return Choice("model.slip", "coulomb", f"partial slip: the stroke {case.stroke * 1e3:.4g} µm is within the "
+                                               f"gross-slip limit δ_t = {transition * 1e3:.4g} µm (μ = {mu:g}): the "
+                                               f"centre sticks and only the slip annulus wears")
+    if case.slip != "auto":
+        return Choice("model.slip", case.slip, "given in the case", True)
+    if mu is None:
+        return Choice("model.slip", "uniform", "no friction coefficient: the paper's gross slip is assumed (give "
+                                               "loading.friction_coefficient to judge the regime)")
+    deficit = transition / case.stroke
+    if deficit > case.accuracy:
+        return Choice("model.slip", "coulomb", f"gross slip (the stroke is {1 / deficit:.1f}× the limit δ_t = "
+                                               f"{transition * 1e3:.4g} µm), but the bodies' elastic tangential "
+                                               f"displacement takes up to δ_t/δ = {deficit:.1%} of the slip, more "
+                                               f"than model.accuracy {case.accuracy:.1%}: Coulomb friction through "
+                                               f"the cycle")
+    return Choice("model.slip", "uniform", f"gross slip far above the limit: the stroke is {1 / deficit:.0f}× "
+                                           f"δ_t = {transition * 1e3:.4g} µm, so uniform slip overestimates the "
+                                           f"slip by at most δ_t/δ = {deficit:.2%}, within model.accuracy "
+                                           f"{case.accuracy:.1%}")
+
+
+def choose_stroke(case: Case, slip: str, grid: Grid) -> Choice:
+    """mid_stroke (one normal solve per cycle, the paper's) or resolved (one per increment, at each position)."""
+    if case.stroke_model != "auto":
+        return Choice("model.stroke", case.stroke_model, "given in the case", True)
+    if slip == "uniform":
+        return Choice("model.stroke", "mid_stroke", "the paper's: the pressure solved at mid-stroke, the flat "
+                                                    "wearing with its stroke average")
+    return Choice("model.stroke", "mid_stroke", "Mindlin's setting: the normal contact at mid-stroke held through "
+                                                "the cycle, each point's slip and traction resolved in increments (a "
+                                                "resolved stroke wears kinks where the contact's edges turn at the "
+                                                "stroke's ends: README)")
+
+
+def _check_cycle_model(case: Case, coarse, corrections, plan: Plan) -> None:
+    """What the incremental cycle does not do, refused or said."""
+    if coarse is not None:
+        raise CaseError(case.source, [("grid.coarse_element", "grid refinement (Eqs. 11-12) applies to the "
+                                                              "uniform-slip model at mid-stroke only; remove "
+                                                              "grid.coarse_element, or use model.slip: uniform")])
+    from fretsim.reference.mindlin import dundurs_beta
+    beta = dundurs_beta(case.moving.youngs_modulus, case.moving.poissons_ratio, case.stationary.youngs_modulus,
+                        case.stationary.poissons_ratio)
+    mu = case.friction_coefficient or 0.0
+    if abs(beta) * mu > case.accuracy:
+        plan.warnings.append(f"dissimilar materials: Dundurs' β = {beta:.3f}, so the shear traction changes the "
+                             f"normal pressure by about βμ = {abs(beta) * mu:.1%} (first order), more than "
+                             f"model.accuracy {case.accuracy:.1%}; fretsim solves the normal and tangential "
+                             f"problems uncoupled and neglects it")
+    if corrections:
+        plan.warnings.append(f"the corrections {', '.join(corrections)} add normal compliance only: the tangential "
+                             f"compliance is the half-spaces'")
 
 
 def _check_model_growth(case: Case, gap_model: str, spectrum: Spectrum, plan: Plan) -> None:
@@ -520,36 +631,6 @@ def _check_model_growth(case: Case, gap_model: str, spectrum: Spectrum, plan: Pl
                                                     f"stroke_average), which is stable")])
     plan.warnings.append(f"the mid-stroke gap model is unstable here (growth rate {rate:.3g} per cycle), but "
                          f"over {case.cycles} cycles a seed grows at most e^{growth:.1f}-fold")
-
-
-def warn_gross_slip(case: Case, e_star: float, hertz, plan: Plan) -> None:
-    """With a friction coefficient: is the stroke beyond the partial-slip limit (gross slip)?
-
-    Point contact (Mindlin; Johnson §7.2): sliding starts at δ* = 3μP/(16 a)·Σ(2 − ν)/G (a for a ball; √(ax·ay)
-    for an ellipse, an estimate).  Line contact: a half-plane has no finite tangential compliance; with a tangential
-    line load Q' = μP' its surface moves u = (2/(πE*))·Q'·ln(d/x) relative to a datum at depth d (Johnson eq.
-    2.19b, both bodies in E*), so with the datum at the radius δ* ≈ (2μP'/(πE*))·ln(2R/a), an estimate.  Below δ*
-    the contact partly sticks and the gross-slip Archard model overestimates the wear.
-    """
-    mu = case.friction_coefficient
-    if mu is None:
-        return
-    if hertz.line:
-        radius = 2 * case.geometry.limits.reach_x
-        limit = 2 * mu * case.normal_load / case.geometry.line_length / (math.pi * e_star) * math.log(
-            2 * radius / hertz.half_width_x)
-    else:
-        inv_g = sum((2 - m.poissons_ratio) * 2 * (1 + m.poissons_ratio) / m.youngs_modulus
-                    for m in (case.moving, case.stationary))
-        limit = 3 * mu * case.normal_load * inv_g / (16 * math.sqrt(hertz.half_width_x * hertz.half_width_y))
-    if case.stroke <= limit:
-        plan.warnings.append(f"the stroke {case.stroke * 1e3:.3g} µm is within the partial-slip limit "
-                             f"{limit * 1e3:.3g} µm for μ = {mu:g}: the contact partly sticks, and the gross-slip "
-                             f"Archard model (this tool's) does not apply; its wear is an overestimate")
-    else:
-        plan.choices.append(Choice("loading.friction_coefficient", mu, f"gross slip: the stroke is "
-                                                                       f"{case.stroke / limit:.1f}× the partial-slip "
-                                                                       f"limit {limit * 1e3:.3g} µm", True))
 
 
 def _show(value: Any) -> str:

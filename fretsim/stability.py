@@ -68,7 +68,8 @@ def wear_spectrum(compliance, stroke: float, k_moving: float, k_stationary: floa
         theta = np.array(THETA)
         f = _halfspace_symbol(grid.plane_strain, grid.dx, grid.dy, grid.shape[0], compliance.e_star, THETA)
         b = stroke_symbol(grid.dx, stroke, theta)
-        rate = 4.0 * stroke * (k_moving + k_stationary * (b if gap_model == "mid_stroke" else b * b))
+        seen = {"mid_stroke": b, "stroke_average": b * b, "resolved": np.ones_like(b)}[gap_model]
+        rate = 4.0 * stroke * (k_moving + k_stationary * seen)
         mu = rate / f
         return Spectrum(float(min(mu.min(), 0.0)), float(mu.max()), "symbol")
     ny, nx = grid.shape
@@ -145,13 +146,14 @@ class GrowthWatch:
     and a 1.5-fold growth are not made that way.  The state is a short list of numbers, kept in the checkpoint.
     """
 
-    def __init__(self, history=()):
+    def __init__(self, history=(), ceiling: bool = True):
         self.history = [float(a) for a in history][-(GROWTH_STEPS + 2):]
+        self.ceiling = ceiling  # off where the model's own pressure has element-scale peaks (a resolved stroke)
 
     def update(self, signed_amplitude: float) -> bool:
         self.history = (self.history + [float(signed_amplitude)])[-(GROWTH_STEPS + 2):]
         a = np.abs(self.history)
-        if a[-1] > CEILING:
+        if self.ceiling and a[-1] > CEILING:
             return True
         if len(a) < GROWTH_STEPS + 2 or a[-1] < NOISE_FLOOR:
             return False

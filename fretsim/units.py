@@ -2,7 +2,8 @@
 
 fretsim works internally in the consistent mm–N–MPa system: lengths in mm,
 forces in N, pressures and moduli in MPa (N/mm²), wear coefficients in 1/MPa
-(mm²/N, so that k·p·s is a length in mm).  Every dimensional value in a case
+(mm²/N, so that k·p·s is a length in mm), energy wear coefficients in mm³/(N·mm) (the same 1/MPa, so that
+α·q·s is a length), tangential stiffnesses in N/mm.  Every dimensional value in a case
 file carries its unit; this module converts it to the internal unit or says
 exactly why it cannot.  It is deliberately tiny (a table, one regex) so that
 the CLI starts quickly in sweeps that launch it thousands of times.
@@ -19,8 +20,13 @@ UNITS: dict[str, dict[str, float]] = {
     "pressure": {"Pa": 1e-6, "kPa": 1e-3, "MPa": 1.0, "GPa": 1e3, "N/mm2": 1.0, "N/mm^2": 1.0},
     "wear_coefficient": {"1/MPa": 1.0, "1/Pa": 1e6, "1/GPa": 1e-3, "mm2/N": 1.0, "mm^2/N": 1.0, "m2/N": 1e6,
                          "m^2/N": 1e6},
+    # worn volume per dissipated energy (Fouvry's α): 1 J = 1000 N·mm
+    "energy_wear_coefficient": {"mm3/J": 1e-3, "mm^3/J": 1e-3, "um3/J": 1e-12, "µm3/J": 1e-12, "µm^3/J": 1e-12,
+                                "m3/J": 1e6, "m^3/J": 1e6, "mm3/Nm": 1e-3, "mm3/(N*m)": 1e-3, "mm3/(N*mm)": 1.0},
+    "stiffness": {"N/mm": 1.0, "N/um": 1e3, "N/µm": 1e3, "kN/mm": 1e3, "N/m": 1e-3, "kN/m": 1.0, "MN/m": 1e3},
 }
-INTERNAL = {"length": "mm", "force": "N", "pressure": "MPa", "wear_coefficient": "1/MPa"}
+INTERNAL = {"length": "mm", "force": "N", "pressure": "MPa", "wear_coefficient": "1/MPa",
+            "energy_wear_coefficient": "mm3/(N*mm)", "stiffness": "N/mm"}
 
 _QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf|nan)\s*(\S+)\s*$", re.IGNORECASE)
 
@@ -63,7 +69,8 @@ def _short(value: object) -> str:
 
 
 def example(dimension: str) -> str:
-    return {"length": "25 um", "force": "185 N", "pressure": "200 GPa", "wear_coefficient": "2.0e-8 1/MPa"}[dimension]
+    return {"length": "25 um", "force": "185 N", "pressure": "200 GPa", "wear_coefficient": "2.0e-8 1/MPa",
+            "energy_wear_coefficient": "2.5e-5 mm3/J", "stiffness": "40 N/um"}[dimension]
 
 
 def format_quantity(value: float, dimension: str) -> str:

@@ -31,7 +31,7 @@ from scipy.ndimage import convolve1d
 from fretsim.compliance import Convolution
 from fretsim.grid import Grid
 
-GAP_MODELS = ("mid_stroke", "stroke_average")
+GAP_MODELS = ("mid_stroke", "stroke_average", "resolved")
 
 
 @lru_cache(maxsize=64)
@@ -89,7 +89,8 @@ def gap_wear(h_moving: np.ndarray, h_stationary: np.ndarray, dx: float, stroke: 
 
 
 def wear_operator(grid: Grid, stroke: float, k_moving: float, k_stationary: float, gap_model: str) -> Convolution:
-    """W: the growth of the gap per cycle per unit pressure, 4δ(k_m I + k_s B) or 4δ(k_m I + k_s B²).
+    """W: the growth of the gap per cycle per unit pressure, 4δ(k_m I + k_s B) or 4δ(k_m I + k_s B²); for a cycle
+    resolved along the stroke (``resolved``: each position sees the flat's wear under it) the bound 4δ(k_m + k_s)I.
 
     An implicit wear step of ΔN cycles solves the contact with C + ΔN·W; the explicit update's stability is
     set by the spectrum of the pencil (W, C).
@@ -98,6 +99,8 @@ def wear_operator(grid: Grid, stroke: float, k_moving: float, k_stationary: floa
     w = stroke_weights(grid.dx, stroke)
     if gap_model == "stroke_average":
         w = np.convolve(w, w)
+    elif gap_model == "resolved":
+        w = np.ones(1)
     elif gap_model != "mid_stroke":
         raise ValueError(f"unknown gap model {gap_model!r}; expected one of {', '.join(GAP_MODELS)}")
     reach = (w.size - 1) // 2
@@ -107,3 +110,93 @@ def wear_operator(grid: Grid, stroke: float, k_moving: float, k_stationary: floa
     row[lo:hi] += k_stationary * w[lo - (nx - 1 - reach):hi - (nx - 1 - reach)]
     row[nx - 1] += k_moving
     return Convolution(grid, 4.0 * stroke * kernel)
+
+
+# --- the flat under a moving body whose points travel differently (the resolved cycle) -----------------------------
+
+def _hat_integral(t: np.ndarray) -> np.ndarray:
+    """∫_{−∞}^{t} of the unit hat (1 − |u|)⁺: 0, (t + 1)²/2, 1 − (1 − t)²/2, 1."""
+    t = np.clip(t, -1.0, 1.0)
+    return np.where(t < 0, 0.5 * (t + 1.0) ** 2, 1.0 - 0.5 * (1.0 - t) ** 2)
+
+
+def _sweep_shares(start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box"):
+    """For each flat element an element's travel reaches: that element (as an offset array) and its share.
+
+    ``box``: a point carries its amount along its travel and leaves it in the flat element it is over (the
+    paper's stroke average, a point per element).  ``hat``: the flat is read between element centres (linear
+    interpolation) and receives by the same weights, so what an element sees changes smoothly as it travels —
+    needed where the pressure is solved at each position, or a travel across an element boundary switches the
+    whole flat by an element at once.
+    """
+    nx = start.shape[1]
+    lo = np.minimum(start, end) / dx
+    hi = np.maximum(start, end) / dx
+    length = hi - lo
+    point = length < 1e-9
+    cols = np.arange(nx)[None, :]
+    if kernel == "box":
+        lo, hi = lo + 0.5, hi + 0.5  # in element widths from the left edge of the element's own cell
+        first = np.floor(lo).astype(int)
+        span = int(np.max(np.ceil(hi) - first)) if start.size else 1
+        for m in range(max(span, 1)):
+            cell = first + m  # the flat element this piece lands in, relative to the moving element's own
+            overlap = np.clip(np.minimum(hi, cell + 1) - np.maximum(lo, cell), 0.0, None)
+            share = np.where(point, (m == 0), overlap / np.where(point, 1.0, length))
+            target = cols + cell
+            yield target, share, (target >= 0) & (target < nx) & (share > 0)
+        return
+    first = np.floor(lo).astype(int)  # the hats that can be non-zero over [lo, hi]: first .. ceil(hi)
+    span = int(np.max(np.ceil(hi) - first)) + 1 if start.size else 2
+    for m in range(max(span, 2)):
+        cell = first + m
+        share = np.where(point, np.clip(1.0 - np.abs(lo - cell), 0.0, None),
+                         (_hat_integral(hi - cell) - _hat_integral(lo - cell)) / np.where(point, 1.0, length))
+        target = cols + cell
+        yield target, share, (target >= 0) & (target < nx) & (share > 0)
+
+
+def sweep_deposit(amount: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box") -> np.ndarray:
+    """What the flat receives when each element j of the moving body carries ``amount[j]`` along its travel from
+    x_j + start[j] to x_j + end[j] (mm, relative to its own centre), spread evenly over the travel.
+
+    The flat's element i receives amount·|travel ∩ element i|/|travel|; a point that does not travel leaves all of
+    it in the flat element under it.  Totals are kept exactly (inside the grid).  With every element travelling
+    the same [−δ, δ] it is the stroke average :func:`stroke_average` times the amount — the generalisation of
+    Eqs. 15–16 to slip that differs from point to point.  Rows (axis 0) are independent; arrays (My, Mx).
+    """
+    ny, nx = amount.shape
+    rows = np.arange(ny)[:, None] * nx
+    out = np.zeros(amount.size)
+    for target, share, inside in _sweep_shares(start, end, dx, kernel):
+        out += np.bincount((rows + target)[inside], weights=(amount * share)[inside], minlength=amount.size)
+    return out.reshape(ny, nx)
+
+
+def sweep_read(field: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box") -> np.ndarray:
+    """The flat's ``field`` as each element j of the moving body sees it over its travel from x_j + start[j] to
+    x_j + end[j]: the travel-weighted average, 0 beyond the grid (unworn).  The adjoint of :func:`sweep_deposit`
+    (same shares), which keeps the resolved cycle's wear modes decaying: a read that is not the deposit's
+    adjoint (interpolation at the travel's midpoint, say) lets short wear modes of the moving body grow."""
+    ny, nx = field.shape
+    rows = np.arange(ny)[:, None]
+    out = np.zeros(field.shape)
+    for target, share, inside in _sweep_shares(start, end, dx, kernel):
+        out += np.where(inside, field[rows, np.clip(target, 0, nx - 1)] * share, 0.0)
+    return out
+
+
+def read_shifted(field: np.ndarray, shift: np.ndarray, dx: float) -> np.ndarray:
+    """``field`` (on the flat) read at x_j + shift[j] for each element j: linear between element centres along x,
+    0 beyond the grid (the flat is unworn there).  The gap a moving point sees over the worn flat."""
+    ny, nx = field.shape
+    pos = np.arange(nx)[None, :] + shift / dx
+    i0 = np.floor(pos).astype(int)
+    w = pos - i0
+    rows = np.arange(ny)[:, None]
+
+    def at(i):
+        ok = (i >= 0) & (i < nx)
+        return np.where(ok, field[rows, np.clip(i, 0, nx - 1)], 0.0)
+
+    return (1.0 - w) * at(i0) + w * at(i0 + 1)

@@ -31,6 +31,11 @@ from fretsim.solvers.result import ContactResult
 REGIMES = ("partial_slip", "gross_slip")
 
 
+class CycleError(Exception):
+    """A cycle that could not be solved (a tangential solve that did not converge); the loop reports it as a
+    numerical failure at the cycle it was asked for."""
+
+
 @dataclass
 class Cycle:
     """What one representative fretting cycle does at a given wear state.  Arrays on the fine grid."""
@@ -89,6 +94,7 @@ def stick_half_width(stick_row: np.ndarray, x: np.ndarray, dx: float) -> float:
 
 
 
-from fretsim.cycle.uniform import UniformCycle  # noqa: E402 - the members need Cycle above
+from fretsim.cycle.coulomb import CoulombCycle  # noqa: E402 - the members need Cycle above
+from fretsim.cycle.uniform import UniformCycle  # noqa: E402
 
-CYCLES: dict[str, type] = {"uniform": UniformCycle}
+CYCLES: dict[str, type] = {"uniform": UniformCycle, "coulomb": CoulombCycle}

@@ -109,14 +109,16 @@ def solve_cg(compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] 
             continue
         tau = float((g * t).sum()) / denom
         p_old = p
-        trial = p - tau * t
-        clipped = bool((trial < 0.0).any())
-        p = np.clip(trial, 0.0, None)
-        if penetrating.any():
-            delta = 0.0
-            p[penetrating] -= tau * g[penetrating]
-        else:
-            delta = 1.0
+        for _ in range(60):
+            trial = p_old - tau * t
+            clipped = bool((trial < 0.0).any())
+            p = np.clip(trial, 0.0, None)
+            if penetrating.any():
+                p[penetrating] -= tau * g[penetrating]
+            if p.sum() > 0.0:
+                break
+            tau *= 0.5  # the step lifted every element off (a rough gap, a poor warm start): a shorter one
+        delta = 0.0 if penetrating.any() else 1.0
         scale = total / p.sum()
         p *= scale
         # Without clipping or added elements p is linear in t, and so is u: one FFT per iteration instead of

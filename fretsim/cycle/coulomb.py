@@ -1,0 +1,241 @@
+"""``coulomb``: the fretting cycle resolved in increments, with Coulomb friction (partial and gross slip).
+
+The rig moves the moving body tangentially by U: 0 → −δ (a first loading quarter, which sets up the history),
+then −δ → +δ → −δ (the loop that is recorded and wears).  At each increment:
+
+* the normal contact — once at mid-stroke for the whole cycle (``stroke_model: mid_stroke``: Mindlin's setting,
+  the pressure fixed), or at each increment with every point of the moving body over the point of the flat it
+  has reached (``resolved``): the gap is ε(ξ) + h_m(ξ) + h_s(ξ + s(ξ)), s the point's accumulated slip;
+* the tangential contact (:func:`fretsim.solvers.tangential.solve_tangential`): the shear traction q with
+  |q| ≤ μp, sticking where |q| < μp, slipping s = ΔU − KΔq where it reaches μp (K: both bodies' tangential
+  compliance, the 2D datum and the rig, :mod:`fretsim.compliance.tangential`).  The increment starts from the
+  previous one's traction, so stick and slip carry their history (Mindlin–Deresiewicz): unloading re-sticks
+  the contact and slip spreads in from its edges;
+* the wear of both bodies from the local slip: Archard dh = k·p·|ds| or, as ``law: energy``, dh = α·|q|·|ds|
+  (Fouvry's dissipated-energy law).  The moving body wears at its own points; each of its points carries its
+  wear along its own travel over the flat (:func:`fretsim.wear.sweep_deposit`), which with equal travel
+  everywhere is exactly the paper's stroke average.
+
+The normal and tangential problems are solved uncoupled: exact for elastically similar bodies, otherwise the
+normal displacement the shear causes (∝ Dundurs' β) is neglected (the plan warns where βμ matters).  The
+convected strain (a flat point's elastic displacement changes as the load slides over it, ∝ μp/E* times the
+travel) is neglected too: it shifts the local slip by about μp₀/E* of the stroke (≲ 1 %).
+
+Cycle jumping.  The rates depend on the slip, which depends on the pressure: they are not linear in it.  An
+implicit step solves each normal contact with C + s·W_lin, W_lin = S_lin/(4δ)·W (W: the uniform member's
+operator at 4δ; for the resolved stroke 4δ(k_m + k_s)I, which bounds every position's), S_lin from the previous
+cycle's slip (``memory``): the load-weighted mean slip, at least half the largest, so that the true stiffness is
+at most twice W_lin's and the step is stable.  The rates it returns are the cycle's own; the mismatch between the
+wear the solve anticipated and the wear found, passed through the step's own response s·W(C + s·W)⁻¹, is
+``Cycle.defect`` — the loop adds it to the step's error estimate.  Invariant: each body's volume is k·Σp|ds|A
+(α·ΣW for the energy law), accumulated cycle by cycle.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from functools import cached_property
+from typing import Optional
+
+import numpy as np
+
+from fretsim.compliance import scaled
+from fretsim.cycle import Cycle, CycleError, stick_half_width
+from fretsim.grid import Grid
+from fretsim.solvers.tangential import solve_tangential
+from fretsim.wear import gap_wear, sweep_deposit, sweep_read, wear_operator
+
+POSITION_TOLERANCE = 0.05  # of an element: a resolved increment is solved again if a point's predicted mid-increment
+#                            position was off by more (the pressure follows the worn flat on that scale)
+LAWS = ("archard", "energy")
+STROKE_MODELS = ("mid_stroke", "resolved")
+
+
+@dataclass(frozen=True)
+class CoulombCycle:
+    grid: Grid
+    compliance: object  # the normal operator C on the grid (its symbol filters the implicit step's mismatch)
+    tangential: object  # K on the grid
+    stroke: float  # mm, the rig's amplitude δ
+    load: float  # on the grid: N (3D) or N/mm (2D)
+    total_load: float  # N
+    friction_coefficient: float
+    k_moving: float  # Archard's k, or α of the energy law (1/MPa = mm³/(N·mm))
+    k_stationary: float
+    law: str = "archard"
+    slip: str = "coulomb"  # coulomb | uniform (rigid tangentially: every point slides with the rig)
+    stroke_model: str = "resolved"
+    gap_model: str = "mid_stroke"  # stroke_model mid_stroke: how the flat's wear enters the mid-stroke gap
+    increments: int = 9  # per half-stroke; odd, so that one is centred on mid-stroke
+    volume_factor: float = 1.0  # the line length in 2D: grid volumes and forces → totals
+    tolerance: float = 1e-10  # the tangential solver's
+    name: str = "coulomb"
+    linear: bool = False
+
+    @property
+    def kernel(self) -> str:
+        """How the flat is read and receives wear along a point's travel (fretsim.wear.sweep_deposit)."""
+        return "hat" if self.stroke_model == "resolved" else "box"
+
+    @property
+    def singular_pressure(self) -> bool:
+        """A resolved stroke wears kinks into both bodies where the contact's edges turn at the stroke's ends; the
+        pressure has (log-)singular peaks there, element-scale on any grid (README: the resolved stroke)."""
+        return self.stroke_model == "resolved"
+
+    @property
+    def invariant(self) -> str:
+        return "k·Σp·|ds|·A" if self.law == "archard" else "α·ΣW"
+
+    # -- the linear operator the implicit steps use, and the explicit stability limit's bound --------------------
+    @cached_property
+    def _w_unit(self):
+        """W at a slip of 4δ everywhere, with the coefficients of p·|ds| (α·μ for the energy law)."""
+        c = self.friction_coefficient if self.law == "energy" else 1.0
+        return wear_operator(self.grid, self.stroke, c * self.k_moving, c * self.k_stationary,
+                             "resolved" if self.stroke_model == "resolved" else self.gap_model)
+
+    def stiffness(self):
+        return self._w_unit
+
+    def expected_volumes(self, cycles: int, work: float) -> tuple[float, float]:
+        return self.k_moving * work, self.k_stationary * work
+
+    def restore(self, pressure):  # pragma: no cover - the loop re-solves a non-linear member instead
+        raise NotImplementedError
+
+    # -- one cycle --------------------------------------------------------------------------------------------
+    def path(self) -> list[tuple[float, float, bool]]:
+        """(U at the start, U at the end, counted) of every increment: 0 → −δ, then the loop −δ → +δ → −δ."""
+        d, n = self.stroke, self.increments
+        nq = (n + 1) // 2
+        quarter = [(-d * k / nq, -d * (k + 1) / nq, False) for k in range(nq)]
+        up = [(-d + 2 * d * k / n, -d + 2 * d * (k + 1) / n, True) for k in range(n)]
+        down = [(d - 2 * d * k / n, d - 2 * d * (k + 1) / n, True) for k in range(n)]
+        return quarter + up + down
+
+    def solve(self, wear_moving, wear_stationary, normal, guess, step: float = 0.0, memory=None,
+              cycle: int = 0) -> Cycle:
+        g, dx = self.grid, self.grid.dx
+        mu, n = self.friction_coefficient, self.increments
+        area = g.area * self.volume_factor
+        slip_lin = float((memory or {}).get("slip_lin", 4.0 * self.stroke))
+        w_lin = scaled(self._w_unit, slip_lin / (4.0 * self.stroke)) if step else None
+        extra = scaled(w_lin, step) if step else None
+        resolved = self.stroke_model == "resolved"
+        if not resolved:
+            seen = gap_wear(wear_moving, wear_stationary, dx, self.stroke, self.gap_model)
+            p_fixed, res_fixed = normal(seen, guess, extra, load=self.load, cycle=cycle)
+        shape = g.shape
+        q, s = np.zeros(shape), np.zeros(shape)
+        rate_m, rate_s = np.zeros(shape), np.zeros(shape)
+        slip_m, slip_s, p_seen, shear = np.zeros(shape), np.zeros(shape), np.zeros(shape), np.zeros(shape)
+        energy = work = 0.0
+        iterations = 0
+        loop_u, loop_q = [], []
+        first = (n + 1) // 2  # the loop's first increment (after the loading quarter)
+        mid, end = first + n // 2, first + n - 1  # centred on U = 0 going up; the up-stroke's end, U = +δ
+        p_prev, ds_prev, du_prev = guess, None, None
+        for k, (u0, u1, counted) in enumerate(self.path()):
+            if k == first:
+                loop_u.append(u0)
+                loop_q.append(float(q.sum()) * area)
+            du = u1 - u0
+            if resolved:
+                same_way = ds_prev is not None and du * du_prev > 0 and self.slip == "coulomb"
+                ds_guess = ds_prev * (du / du_prev) if same_way else np.full(shape, du)
+                p, res = normal(wear_moving + sweep_read(wear_stationary, s, s + ds_guess, dx, self.kernel), p_prev, extra,
+                                load=self.load, cycle=cycle)
+                iterations += res.iterations
+            else:
+                p, res, ds_guess = p_fixed, res_fixed, None
+            q_new, ds, stuck, its = self._tangential(q, p, du)
+            iterations += its
+            if resolved and self.slip == "coulomb":
+                off = np.abs(ds - ds_guess)[p > 0]
+                if off.size and off.max() > 2 * POSITION_TOLERANCE * dx:  # solve again where the points really went
+                    ds_guess = ds
+                    p, res = normal(wear_moving + sweep_read(wear_stationary, s, s + ds, dx, self.kernel), p, extra,
+                                    load=self.load, cycle=cycle)
+                    q_new, ds, stuck, its = self._tangential(q, p, du)
+                    iterations += res.iterations + its
+            if counted:
+                amount = p * np.abs(ds) if self.law == "archard" else np.abs(q_new) * np.abs(ds)
+                rate_m += self.k_moving * amount
+                rate_s += self.k_stationary * sweep_deposit(amount, s, s + ds, dx, self.kernel)
+                slip_m += np.abs(ds)
+                slip_s += sweep_deposit(np.abs(ds), s, s + ds, dx, self.kernel)
+                p_seen += sweep_deposit(p, s, s + ds, dx, self.kernel)
+                energy += float((np.abs(q_new) * np.abs(ds)).sum()) * area
+                work += float(amount.sum()) * area
+                shear = np.maximum(shear, np.abs(q_new))
+                loop_u.append(u1)
+                loop_q.append(float(q_new.sum()) * area)
+            if k == mid:
+                p_mid, res_mid, travel_mid = p, res, (s, s + ds)
+            if k == end:
+                stick_end = stuck & (p > 0)
+            s, q = s + ds, q_new
+            p_prev, ds_prev, du_prev = p, ds, du
+        p_seen /= 2 * n
+        defect = 0.0
+        if step:
+            # the gap growth the mid-stroke solve anticipated against what the cycle found for that position
+            found = rate_m + (sweep_read(rate_s, *travel_mid, dx, self.kernel) if resolved else
+                              gap_wear(np.zeros(shape), rate_s, dx, self.stroke, self.gap_model))
+            deepest = np.unravel_index(np.argmax(wear_moving + wear_stationary), shape)
+            defect = abs(float(self._response(step, w_lin, step * (found - w_lin(p_mid)))[deepest]))
+        on = p_mid > 0
+        s_mean = float((p_mid * slip_m).sum() / p_mid.sum())
+        s_max = float(slip_m[on].max()) if on.any() else 0.0
+        return Cycle(
+            pressure=p_mid, pressure_stationary=p_seen, rate_moving=rate_m, rate_stationary=rate_s,
+            slip_moving=slip_m, slip_stationary=slip_s, shear=shear, energy=energy, work=work,
+            force_amplitude=float(np.abs(loop_q).max()),
+            regime="partial_slip" if stick_end.any() else "gross_slip",
+            stick_half_width_x=stick_half_width(stick_end[shape[0] // 2], g.x, dx), contact=res_mid,
+            iterations=iterations, loop=(np.array(loop_u), np.array(loop_q)),
+            memory={"slip_lin": max(s_mean, 0.5 * s_max, 1e-300)}, defect=defect)
+
+    def _tangential(self, q, p, du):
+        """One increment's traction, slip and stick set; rigid bodies (``slip: uniform``) slide with the rig."""
+        if self.slip == "uniform":
+            on = p > 0
+            return np.where(on, np.sign(du) * self.friction_coefficient * p, 0.0), np.where(on, du, 0.0), \
+                np.zeros(p.shape, bool), 0
+        on = p > 0
+        rhs = self.tangential(q) + du  # on the whole grid: the old traction may reach beyond the new contact
+        rows, cols = _span(on.any(axis=1)), _span(on.any(axis=0))
+        res = solve_tangential(self.tangential.window(rows, cols), rhs[rows, cols],
+                               self.friction_coefficient * p[rows, cols], q[rows, cols], tol=self.tolerance)
+        if not res.success:
+            raise CycleError(f"the tangential contact did not converge: {res.message}")
+        q_new, ds, stuck = np.zeros(p.shape), np.zeros(p.shape), np.zeros(p.shape, bool)
+        q_new[rows, cols], ds[rows, cols], stuck[rows, cols] = res.traction, res.slip, res.stick
+        return q_new, ds, stuck, res.iterations
+
+    def _response(self, step: float, w_lin, mismatch: np.ndarray) -> np.ndarray:
+        """What a gap mismatch does to the wear of an implicit step: s·W(C + s·W)⁻¹ applied by Fourier symbols
+        (the contact set ignored), so a smooth mismatch, which the pressure absorbs, counts little."""
+        conv = getattr(self.compliance, "convolution", None)
+        c_hat = conv.hat if conv is not None else self.compliance.hat
+        w_hat = step * w_lin.hat
+        return w_lin.backward(w_lin.forward(mismatch) * (w_hat / (c_hat + w_hat)))
+
+
+def _span(mask: np.ndarray) -> slice:
+    """The rows (or columns) from the first to the last in contact: shear traction lives only there."""
+    idx = np.flatnonzero(mask)
+    return slice(int(idx[0]), int(idx[-1]) + 1) if idx.size else slice(0, 1)
+
+
+def gross_slip_stroke(tangential, pressure: np.ndarray, friction_coefficient: float) -> float:
+    """δ_t (mm): the rig displacement at which the last point of a contact under ``pressure`` starts to slide.
+
+    In full sliding every point carries q = μp, so a point has slid once the rig displacement exceeds the elastic
+    displacement K·μp there; the last to go is where that is largest.  The cyclic loop reaches gross slip at the
+    same amplitude (Masing: the traction reverses over 2δ_t).  For a Hertzian ball it is Mindlin's
+    3μP/(16a)·Σ(2 − ν)/G; in 2D it depends on the datum (:mod:`fretsim.compliance.tangential`).
+    """
+    u = tangential(friction_coefficient * pressure)
+    on = pressure > 0
+    return float(u[on].max()) if on.any() else 0.0

@@ -1,0 +1,285 @@
+"""Coulomb friction through the fretting cycle against Mindlin's closed forms, the invariants, and the models it
+reduces to.
+
+Tolerances, with their reasons:
+* SOLVER (1e-8): two routes to one discrete solution (the tangential solver against a dense QP).
+* FORCE (1e-3 at 32 elements across, shrinking with the grid): Q(δ) of a discretised Hertz contact; its error
+  is the pressure's (second order in the element size).
+* ENERGY (3e-2 at 32 across, 1e-3 at 64 for the ball; 3e-3 at 128–256 for the cylinder): the loop's dissipated
+  energy; small loops are a difference of nearly equal terms (W ∝ Q*³), so their error is amplified at coarse
+  grids.
+* STICK: the stick zone is resolved to an element (its edge falls between element centres): |c − c_exact| ≤ dx.
+"""
+from __future__ import annotations
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import lsq_linear
+
+from fretsim.compliance import HalfSpace, add
+from fretsim.compliance.tangential import Tangential, cerruti_rectangle, datum_distance
+from fretsim.cycle import CoulombCycle, UniformCycle
+from fretsim.grid import Grid
+from fretsim.reference import effective_modulus, mindlin as M
+from fretsim.solvers import solve
+from fretsim.solvers.tangential import solve_tangential
+from fretsim.wear import wear_operator
+
+E, NU = 200e3, 0.3
+BODIES = [(E, NU), (E, NU)]
+E_STAR = effective_modulus(E, NU, E, NU)
+
+
+def ball_contact(n: int, load=185.0, radius=6.0, extent=3.0):
+    """A ball's unworn contact on an n × n grid spanning ``extent`` Hertz radii: grid, operators, a ``normal``."""
+    a = (3 * load * radius / (4 * E_STAR)) ** (1 / 3)
+    dx = extent * a / n
+    grid = Grid.centred(n, n, dx, dx)
+    c = HalfSpace(grid, E_STAR)
+    x, y = grid.mesh()
+    gap = (x**2 + y**2) / (2 * radius)
+
+    def normal(seen, guess, extra=None, load=load, cycle=0):
+        res = solve(c if extra is None else add(c, extra), gap + seen, load, p0=guess, tol=1e-12)
+        return res.pressure, res
+
+    return grid, c, Tangential(grid, BODIES), normal, a
+
+
+def cylinder_contact(n: int, load_per_length=18.5, radius=6.0, length=10.0, extent=3.0):
+    a = math.sqrt(4 * load_per_length * radius / (math.pi * E_STAR))
+    dx = extent * a / n
+    grid = Grid.centred(n, 1, dx, 1.0, plane_strain=True)
+    c = HalfSpace(grid, E_STAR)
+    gap = grid.x[None, :] ** 2 / (2 * radius)
+
+    def normal(seen, guess, extra=None, load=load_per_length, cycle=0):
+        res = solve(c, gap + seen, load, p0=guess, tol=1e-12)
+        return res.pressure, res
+
+    return grid, c, Tangential(grid, BODIES, line_length=length), normal, a
+
+
+def fretting_cycle(grid, c, k, stroke, load, mu, volume_factor=1.0, **kw):
+    return CoulombCycle(grid, c, k, stroke, load, load * volume_factor, mu, 2e-8, 3e-8, stroke_model="mid_stroke",
+                        volume_factor=volume_factor, **kw)
+
+
+# --- the tangential operator and solver -------------------------------------------------------------------------
+
+def test_cerruti_rectangle_matches_a_quadrature_of_the_point_force_solution():
+    """Outside the rectangle a plain double quadrature; inside, polar coordinates about the point, where the
+    integrand times r is (1 + ν)/(πE)·[(1 − ν) + ν cos²θ] and only the distance to the edge R(θ) remains."""
+    from scipy.integrate import dblquad, quad
+    a, b = 0.5, 0.8
+    for x, y in ((1.7, 0.4), (-4.0, 6.0), (0.6, 0.0)):
+        def f(eta, xi):
+            r = math.hypot(x - xi, y - eta)
+            return (1 + NU) / (math.pi * E) * ((1 - NU) / r + NU * (x - xi) ** 2 / r**3)
+        ref, _ = dblquad(f, -a, a, -b, b, epsabs=1e-14, epsrel=1e-10)
+        assert cerruti_rectangle(x, y, a, b, E, NU) == pytest.approx(ref, rel=1e-7)
+    for x, y in ((0.0, 0.0), (0.3, -0.2), (-0.45, 0.7)):
+        def edge(t):  # distance from (x, y) to the rectangle's boundary along the direction t
+            c, s_ = math.cos(t), math.sin(t)
+            return min((a - x) / c if c > 0 else (-a - x) / c if c < 0 else math.inf,
+                       (b - y) / s_ if s_ > 0 else (-b - y) / s_ if s_ < 0 else math.inf)
+        corners = sorted(math.atan2(cy - y, cx - x) % (2 * math.pi) for cx in (-a, a) for cy in (-b, b))
+        ref = quad(lambda t: (1 + NU) / (math.pi * E) * ((1 - NU) + NU * math.cos(t) ** 2) * edge(t), 0, 2 * math.pi,
+                   points=corners, epsabs=1e-15, epsrel=1e-11, limit=200)[0]
+        assert cerruti_rectangle(x, y, a, b, E, NU) == pytest.approx(ref, rel=1e-8)
+
+
+def test_the_2d_datum_makes_a_line_load_move_as_the_3d_half_space_on_average():
+    """The 2D datum (d = 2L·e^{ν/(1−ν)−1}) is derived from the 3D kernel averaged along the line; check that
+    derivation numerically: the mean over y of the 3D displacement of a uniform line load of length L."""
+    from scipy.integrate import quad
+    length, x0 = 10.0, 0.02
+
+    def u3(y):  # the 3D displacement at (x0, y) of a unit line load along [−L/2, L/2], one body
+        f = lambda eta: (1 + NU) / (math.pi * E) * ((1 - NU) / math.hypot(x0, y - eta)  # noqa: E731
+                                                    + NU * x0**2 / math.hypot(x0, y - eta) ** 3)
+        return quad(f, -length / 2, length / 2, points=[y], limit=200)[0]
+
+    mean3 = quad(u3, -length / 2, length / 2, limit=200)[0] / length
+    u2 = 2 * (1 - NU**2) / (math.pi * E) * math.log(datum_distance(length, NU) / x0)
+    assert mean3 == pytest.approx(u2, rel=2e-3)  # the closed form drops O(x0/L) terms: 2e-3 at x0/L = 2e-3
+
+
+def test_tangential_solver_agrees_with_a_dense_bounded_least_squares_solution():
+    grid, c, k, normal, a = ball_contact(20)
+    p, _ = normal(np.zeros(grid.shape), None)
+    rng = np.random.default_rng(1)
+    q0 = np.clip(rng.normal(0, 20, grid.shape), -0.5 * p, 0.5 * p)
+    rhs = k(q0) + 3e-4
+    res = solve_tangential(k, rhs, 0.5 * p, q0, tol=1e-13)
+    on = (p > 0).ravel()
+    kd = k.dense()[np.ix_(on, on)]
+    chol = np.linalg.cholesky(kd)  # ½qᵀKq − bᵀq = ½‖Lᵀq − L⁻¹b‖² + const
+    ref = lsq_linear(chol.T, np.linalg.solve(chol, rhs.ravel()[on]), bounds=(-0.5 * p.ravel()[on], 0.5 * p.ravel()[on]),
+                     tol=1e-14, lsmr_tol="auto", max_iter=10000)
+    assert res.success, res.message
+    assert np.abs(res.traction.ravel()[on] - ref.x).max() < 1e-6 * 0.5 * p.max()
+    # the slip it reports is the increment's: zero where it sticks, along the traction where it slips
+    slipping = ~res.stick & (p > 0)
+    assert np.all(res.slip[res.stick] == 0)
+    assert np.all(res.slip[slipping] * res.traction[slipping] >= 0)
+
+
+# --- Mindlin: the ball (3D) -------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("fraction", [0.3, 0.7])
+def test_ball_partial_slip_loop_matches_mindlin_deresiewicz_and_converges(fraction):
+    errors = []
+    for n in (32, 64):
+        grid, c, k, normal, a = ball_contact(n)
+        mu = 0.6
+        stroke = fraction * M.ball_gross_slip_displacement(mu, 185.0, a, BODIES)
+        cyc = fretting_cycle(grid, c, k, stroke, 185.0, mu).solve(np.zeros(grid.shape), np.zeros(grid.shape),
+                                                                  normal, None)
+        q_star = M.ball_force(stroke, mu, 185.0, a, BODIES)
+        assert cyc.regime == "partial_slip"
+        assert abs(cyc.stick_half_width_x - M.ball_stick_radius(q_star, mu, 185.0) * a) <= grid.dx
+        errors.append((abs(cyc.force_amplitude / q_star - 1),
+                       abs(cyc.energy / M.ball_loop_energy(q_star, mu, 185.0, a, BODIES) - 1)))
+        # the traction at the stroke's end: Cattaneo–Mindlin, to the pressure's discretisation
+        r = np.hypot(*grid.mesh())
+        assert np.abs(cyc.shear - M.ball_traction(r, q_star, mu, 185.0, a)).max() < 0.06 * mu * cyc.pressure.max()
+    (f32, w32), (f64, w64) = errors
+    assert f32 < 1e-3 and w32 < 3e-2
+    assert f64 < 0.5 * f32 and w64 < 1e-3  # converging with the element size
+
+
+def test_gross_slip_begins_at_mindlins_displacement():
+    grid, c, k, normal, a = ball_contact(64)
+    from fretsim.cycle.coulomb import gross_slip_stroke
+    p, _ = normal(np.zeros(grid.shape), None)
+    assert gross_slip_stroke(k, p, 0.6) == pytest.approx(M.ball_gross_slip_displacement(0.6, 185.0, a, BODIES),
+                                                         rel=3e-3)  # the centre's displacement: the pressure's error
+
+
+def test_above_the_transition_the_contact_slides_as_a_whole_and_dissipates_four_mu_p_delta_less_the_elastic_part():
+    grid, c, k, normal, a = ball_contact(48)
+    mu = 0.6
+    d_t = M.ball_gross_slip_displacement(mu, 185.0, a, BODIES)
+    for factor in (2.0, 20.0):
+        cyc = fretting_cycle(grid, c, k, factor * d_t, 185.0, mu).solve(np.zeros(grid.shape), np.zeros(grid.shape),
+                                                                         normal, None)
+        assert cyc.regime == "gross_slip" and cyc.stick_half_width_x == 0
+        assert cyc.force_amplitude == pytest.approx(mu * 185.0, rel=1e-9)
+        # W = 4μP(δ − δ_e): each point slides 4(δ − its elastic displacement under μp); δ_e lies within (0, δ_t)
+        elastic = factor * d_t - cyc.energy / (4 * mu * 185.0)
+        assert 0.0 < elastic < d_t
+    # and as the stroke grows the local-slip wear approaches the uniform model's within model.accuracy
+    wide = fretting_cycle(grid, c, k, 100 * d_t, 185.0, mu).solve(np.zeros(grid.shape), np.zeros(grid.shape),
+                                                                   normal, None)
+    uniform = 4 * 100 * d_t * 2e-8 * wide.pressure
+    assert np.abs(wide.rate_moving - uniform).max() <= 0.01 * uniform.max()
+
+
+def test_partial_slip_wears_an_annulus_and_nothing_where_it_sticks():
+    grid, c, k, normal, a = ball_contact(64)
+    mu = 0.6
+    stroke = 0.5 * M.ball_gross_slip_displacement(mu, 185.0, a, BODIES)
+    cyc = fretting_cycle(grid, c, k, stroke, 185.0, mu).solve(np.zeros(grid.shape), np.zeros(grid.shape), normal, None)
+    q_star = M.ball_force(stroke, mu, 185.0, a, BODIES)
+    c_exact = M.ball_stick_radius(q_star, mu, 185.0) * a
+    r = np.hypot(*grid.mesh())
+    inside, annulus = r < c_exact - grid.dx, (r > c_exact + grid.dx) & (cyc.pressure > 0)
+    assert cyc.rate_moving[inside].max() == 0.0 and cyc.slip_moving[inside].max() == 0.0
+    assert (cyc.rate_moving[annulus] > 0).mean() > 0.95
+
+
+# --- Cattaneo: the cylinder (2D) ------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("fraction", [0.4, 0.8])
+def test_cylinder_partial_slip_matches_cattaneo_and_its_loop_energy_ignores_the_datum(fraction):
+    """The datum of a 2D displacement is arbitrary: it sets how much stroke the bodies take up (δ_t), but the loop
+    an amplitude Q* makes, and so its energy, are Cattaneo's whatever it is."""
+    from fretsim.cycle.coulomb import gross_slip_stroke
+    mu = 0.6
+    for n in (128, 256):
+        grid, c, k, normal, a = cylinder_contact(n)
+        p, _ = normal(np.zeros(grid.shape), None)
+        transitions = []
+        for length in (10.0, 100.0):  # the same contact with its datum ten times as far
+            kk = Tangential(grid, BODIES, line_length=length)
+            transitions.append(gross_slip_stroke(kk, p, mu))
+            cyc = fretting_cycle(grid, c, kk, fraction * transitions[-1], 18.5, mu).solve(
+                np.zeros(grid.shape), np.zeros(grid.shape), normal, None)
+            q_star = cyc.force_amplitude  # per unit length: the grid is per unit length, volume factor 1
+            assert cyc.regime == "partial_slip"
+            assert abs(cyc.stick_half_width_x - M.cylinder_stick_half_width(q_star, mu, 18.5) * a) <= grid.dx
+            # a small loop's energy (∝ Q*³) is a difference of near-equal terms: where the stick edge falls within
+            # an element moves it by up to ~1e-3 here (2.5e-2 at 64 elements, 4e-5 at 512, measured)
+            assert cyc.energy == pytest.approx(M.cylinder_loop_energy(q_star, mu, 18.5, E_STAR), rel=3e-3)
+        # the farther datum takes up more stroke: (2/πE*)·μP′·ln 10 more, exactly (the kernels differ by a constant)
+        extra = 2 / (math.pi * E_STAR) * mu * 18.5 * math.log(10.0)
+        assert transitions[1] - transitions[0] == pytest.approx(extra, rel=1e-9)
+
+
+def test_a_long_cylinder_takes_up_the_stroke_in_2d_as_in_3d():
+    """The 2D datum is chosen so that the 2D model of a line contact shares the stroke with its bodies as the 3D
+    half-space model does: the displacement at which gross slip begins, 2D against 3D on a long cylinder."""
+    from fretsim.cycle.coulomb import gross_slip_stroke
+    radius, length, load = 6.0, 10.0, 185.0
+    a = math.sqrt(4 * load / length * radius / (math.pi * E_STAR))
+    dx = 7 * a / 40
+    g2 = Grid.centred(61, 1, dx, 1.0, plane_strain=True)
+    g3 = Grid.centred(61, 41, dx, length / 41)
+    out = []
+    for g, lf in ((g2, load / length), (g3, load)):
+        x, y = g.mesh()
+        gap = x**2 / (2 * radius) if g.plane_strain else np.where(np.abs(y) <= length / 2, x**2 / (2 * radius), np.inf)
+        p = solve(HalfSpace(g, E_STAR), gap, lf, tol=1e-12).pressure
+        k = Tangential(g, BODIES, line_length=length if g.plane_strain else None)
+        out.append(gross_slip_stroke(k, p, 0.9))
+    assert out[0] == pytest.approx(out[1], rel=0.05)  # a finite 3D line's ends take up a little less
+
+
+# --- the models it reduces to, and the invariants ----------------------------------------------------------------
+
+def test_rigid_slip_through_the_cycle_is_the_papers_stroke_average_to_round_off():
+    """With every point sliding with the rig (slip: uniform) the incremental cycle's flat wear, summed over the
+    increments of the travel, is exactly the paper's stroke-averaged pressure times 4δ."""
+    grid, c, k, normal, a = cylinder_contact(96)
+    rng = np.random.default_rng(3)
+    h_m = np.clip(rng.normal(1e-4, 3e-5, grid.shape), 0, None) * (np.abs(grid.x) < 2 * a)
+    h_s = np.clip(rng.normal(1e-4, 3e-5, grid.shape), 0, None) * (np.abs(grid.x) < 2 * a)
+    stroke = 0.4 * a
+    w = wear_operator(grid, stroke, 2e-8, 3e-8, "mid_stroke")
+    paper = UniformCycle(grid, w, stroke, 18.5, 185.0, 2e-8, 3e-8, "mid_stroke")
+    ours = fretting_cycle(grid, c, k, stroke, 18.5, 0.6, volume_factor=10.0, slip="uniform")
+    a_cyc = paper.solve(h_m, h_s, normal, None)
+    b_cyc = ours.solve(h_m, h_s, normal, None)
+    scale = a_cyc.rate_stationary.max()
+    assert np.abs(a_cyc.rate_stationary - b_cyc.rate_stationary).max() < 1e-12 * scale
+    assert np.abs(a_cyc.rate_moving - b_cyc.rate_moving).max() < 1e-12 * scale
+    assert np.abs(a_cyc.pressure_stationary - b_cyc.pressure_stationary).max() < 1e-12 * a_cyc.pressure.max()
+    assert b_cyc.work == pytest.approx(a_cyc.work, rel=1e-12)
+
+
+def test_the_energy_law_is_archard_with_k_equal_alpha_mu_and_conserves_alpha_times_the_energy():
+    grid, c, k, normal, a = ball_contact(40)
+    mu, stroke = 0.6, 0.4 * M.ball_gross_slip_displacement(0.6, 185.0, a, BODIES)
+    archard = CoulombCycle(grid, c, k, stroke, 185.0, 185.0, mu, 2e-8 * mu, 3e-8 * mu, stroke_model="mid_stroke")
+    energy = CoulombCycle(grid, c, k, stroke, 185.0, 185.0, mu, 2e-8, 3e-8, law="energy", stroke_model="mid_stroke")
+    zero = np.zeros(grid.shape)
+    x, y = archard.solve(zero, zero, normal, None), energy.solve(zero, zero, normal, None)
+    assert np.abs(x.rate_moving - y.rate_moving).max() <= 1e-9 * x.rate_moving.max()
+    assert y.work == pytest.approx(y.energy, rel=1e-12)  # the energy law's invariant is ΣW
+    area = grid.area
+    assert y.rate_moving.sum() * area == pytest.approx(2e-8 * y.energy, rel=1e-12)
+    assert y.rate_stationary.sum() * area == pytest.approx(3e-8 * y.energy, rel=1e-9)  # deposited in the grid
+
+
+def test_the_loops_area_is_the_dissipated_energy():
+    grid, c, k, normal, a = ball_contact(40)
+    stroke = 0.6 * M.ball_gross_slip_displacement(0.6, 185.0, a, BODIES)
+    cyc = fretting_cycle(grid, c, k, stroke, 185.0, 0.6, increments=101).solve(np.zeros(grid.shape),
+                                                                               np.zeros(grid.shape), normal, None)
+    u, q = cyc.loop
+    area = abs(float(np.sum(0.5 * (q[1:] + q[:-1]) * np.diff(u))))
+    assert u[0] == pytest.approx(-stroke) and u[-1] == pytest.approx(-stroke) and q[0] == pytest.approx(q[-1])
+    assert area == pytest.approx(cyc.energy, rel=2e-3)  # the trapezoid rule on 202 points of a smooth loop
