@@ -519,6 +519,7 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
                   volume_factor=volume_factor, limits=g.limits, y_edges_free=g.y_edges_free,
                   eta=case.eta, max_jump=max_jump, step_tolerance=case.step_tolerance, implicit_cap=cap, coarse=coarse,
                   coarse_compliance=coarse_op, coarse_gap=coarse_gap, per_cycle=per_cycle,
+                  gross_slip_stroke=transition if transition is not None else float("nan"),
                   notes=tuple(f"{c.key} = {_show(c.value)}: {c.reason}" for c in plan.choices if not c.given)
                   + tuple(plan.warnings))
     filled = case.with_choices(dimension=dimension, corrections=corrections or "none",

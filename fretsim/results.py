@@ -9,12 +9,16 @@
     /fields/<name>     at the snapshot cycles: (cycle, y, x), with ``cycle``, ``y``, ``x`` as dimension scales
     /summary           attrs: the run's headline figures (same names as `fretsim summary`), and the same values
                        as scalar datasets each with its ``units``
+    /fretting_loop     at the snapshot cycles: the applied displacement and the tangential force round the loop,
+                       (cycle, point); no points for the uniform-slip model, which has no loop
     /checkpoint        the loop's state at the last written step, for `fretsim run --resume` (attr sha256)
 
 The layout is a contract (README): names are only ever added.  Every dataset has ``units`` and ``long_name``,
 and the dimension scales make ``xarray.open_dataset(path, engine="h5netcdf", group="fields")`` come out
 labelled.  Format 1.2 adds /inputs, /choices, the dimension scales, the summary datasets and the checksums to
-1.1; a 1.1 file is still read.
+1.1; format 1.3 adds friction: the slip-distance and shear-traction fields, the dissipated energy and the
+invariant's work in the history, /fretting_loop, and the regime in the summary.  1.1 and 1.2 files are still
+read.
 
 Writing.  The writer keeps the run in memory and at every flush builds the whole file as an in-memory HDF5
 image, writes it with plain file I/O to a temporary file beside the target, fsyncs it and renames it over the
@@ -53,8 +57,8 @@ import numpy as np
 from fretsim import __version__
 from fretsim.errors import ResultsFileError
 
-FORMAT_VERSION = "1.2"
-READABLE_FORMATS = ("1.1", "1.2")
+FORMAT_VERSION = "1.3"
+READABLE_FORMATS = ("1.1", "1.2", "1.3")
 FLUSH_SECONDS = 0.5
 FLUSH_COST_FACTOR = 20.0  # flushes no more often than this many times their own cost (≤ ~5 % of the run)
 STATUSES = ("running", "complete", "interrupted", "failed", "stopped")
@@ -80,16 +84,31 @@ HISTORY = {
     "rejected_steps": ("1", "steps rejected since the previous accepted one", lambda s: s.rejected),
     "error_estimate_depth": ("1", "estimated relative error of the maximum depths", lambda s: s.error_depth),
     "error_estimate_pressure": ("1", "estimated relative error of the pressure field", lambda s: s.error_pressure),
+    "dissipated_energy_J": ("J", "energy dissipated per cycle by friction at this state (NaN: no friction "
+                                 "coefficient)", lambda s: s.cycle_result.energy * 1e-3),
+    "wear_work": ("N*mm", "the wear invariant's work accumulated: Σp·|ds|·A (Archard) or Σ|q|·|ds|·A (energy "
+                          "law) over the cycles; each body's wear volume is its coefficient times it",
+                  lambda s: s.work),
 }
 INTEGER_HISTORY = {"cycle", "solver_iterations", "cycle_jump", "rejected_steps"}
-HISTORY_V11 = [k for k in HISTORY if not k.startswith("error_estimate")]  # a 1.1 file has these
+HISTORY_V11 = [k for k in HISTORY if not k.startswith("error_estimate") and k not in ("dissipated_energy_J",
+                                                                                        "wear_work")]
+HISTORY_V12 = [k for k in HISTORY if k not in ("dissipated_energy_J", "wear_work")]
 FIELDS = {
     "wear_depth_moving": ("um", "wear depth of the moving body", lambda s: s.wear_moving * 1e3),
     "wear_depth_stationary": ("um", "wear depth of the stationary body", lambda s: s.wear_stationary * 1e3),
     "pressure": ("MPa", "contact pressure on the moving body at mid-stroke", lambda s: s.pressure),
     "pressure_stationary_average": ("MPa", "stroke-averaged pressure on the stationary body",
                                     lambda s: s.pressure_average),
+    "slip_distance_moving": ("um", "slip distance per cycle at each point of the moving body",
+                             lambda s: s.cycle_result.slip_moving * 1e3),
+    "slip_distance_stationary": ("um", "slip distance per cycle at each point of the stationary body",
+                                 lambda s: s.cycle_result.slip_stationary * 1e3),
+    "shear_traction": ("MPa", "amplitude of the shear traction on the moving body over the cycle (NaN: not "
+                              "modelled)", lambda s: s.cycle_result.shear),
 }
+FIELDS_V12 = [k for k in FIELDS if not k.startswith(("slip_distance", "shear"))]
+NAN_FIELDS = {"shear_traction"}  # the uniform model without a friction coefficient does not know it
 SUMMARY_UNITS = {
     "cycles": "cycles", "contact_solves": "1", "wall_time_s": "s", "max_wear_depth_moving_um": "um",
     "max_wear_depth_stationary_um": "um", "centre_wear_depth_moving_um": "um",
@@ -97,9 +116,12 @@ SUMMARY_UNITS = {
     "wear_volume_moving_mm3": "mm^3", "wear_volume_stationary_mm3": "mm^3", "archard_volume_error": "1",
     "max_pressure_MPa": "MPa", "linear_jump": "cycles", "stability_limit_linear": "cycles",
     "element_size_x_um": "um", "element_size_y_um": "um", "elements_x": "1", "elements_y": "1",
-    "error_estimate_depth": "1", "error_estimate_pressure": "1",
+    "error_estimate_depth": "1", "error_estimate_pressure": "1", "regime": "", "tangential_force_amplitude_N": "N",
+    "dissipated_energy_per_cycle_J": "J", "stick_half_width_x_mm": "mm", "gross_slip_stroke_um": "um",
 }
-NAN_SUMMARY = {"element_size_y_um", "stability_limit_linear"}  # NaN in 2D; infinite when nothing wears
+# NaN in 2D; infinite when nothing wears; unknown without a friction coefficient
+NAN_SUMMARY = {"element_size_y_um", "stability_limit_linear", "tangential_force_amplitude_N",
+               "dissipated_energy_per_cycle_J", "gross_slip_stroke_um"}
 
 
 class ResultsIOError(OSError):
@@ -232,8 +254,11 @@ class ResultsWriter:
                                                 for k in HISTORY))] if len(previous.history.get("cycle", [])) else []
             self.fields = {k: list(previous.fields[k]) for k in FIELDS}
             self.field_cycles = list(previous.fields["cycle"])
+            self.loops = [tuple(pair) for pair in zip(previous.fretting_loop["displacement"],
+                                                      previous.fretting_loop["tangential_force"])]
         else:
             self.rows, self.fields, self.field_cycles = [], {k: [] for k in FIELDS}, []
+            self.loops = []  # (applied displacement um, tangential force N) at each snapshot
         self.status, self.message, self.summary = "running", "", {}
         self.state: Optional[dict] = None
         self._flushed = -math.inf
@@ -247,6 +272,8 @@ class ResultsWriter:
             self.field_cycles.append(step.cycle)
             for name, (_, _, get) in FIELDS.items():
                 self.fields[name].append(np.array(get(step)))
+            loop = step.cycle_result.loop
+            self.loops.append((loop[0] * 1e3, loop[1]) if loop is not None else (np.zeros(0), np.zeros(0)))
         self.state = step.state
         # at most every FLUSH_SECONDS, the first FLUSH_SECONDS into the run: each flush rewrites the whole file,
         # a kill costs at most the steps since the last one (which --resume recomputes), and a run shorter than
@@ -362,6 +389,21 @@ class ResultsWriter:
             ds.attrs.update(units=units, long_name=long_name)
             for axis, scale in enumerate(scales):
                 ds.dims[axis].attach_scale(scale)
+        lp = f.create_group("fretting_loop")
+        lp.attrs["long_name"] = ("the fretting loop at each snapshot: the rig's displacement and the tangential "
+                                 "force round one cycle (−δ → +δ → −δ); no points for uniform slip")
+        lcyc = lp.create_dataset("cycle", data=np.array(self.field_cycles, dtype="i8"))
+        lcyc.make_scale("cycle")
+        lcyc.attrs.update(units="cycles", long_name="cycle number of the snapshot")
+        points = max((len(u) for u, _ in self.loops), default=0)
+        for name, k, units, long_name in (("displacement", 0, "um", "the rig's tangential displacement"),
+                                          ("tangential_force", 1, "N", "the tangential force Q (total)")):
+            data = np.full((len(self.loops), points), np.nan)
+            for i, pair in enumerate(self.loops):
+                data[i, :len(pair[k])] = pair[k]
+            ds = lp.create_dataset(name, data=data)
+            ds.attrs.update(units=units, long_name=long_name)
+            ds.dims[0].attach_scale(lcyc)
         s = f.create_group("summary")
         for key, value in self.summary.items():
             s.attrs[key] = value
@@ -423,6 +465,7 @@ class Results:
     summary: dict
     units: dict
     checkpoint: Optional[dict] = None
+    fretting_loop: dict = field(default_factory=dict)  # cycle, displacement (um), tangential_force (N)
     choices: list = field(default_factory=list)  # (key, value, reason) of every automatic choice
     inputs: dict = field(default_factory=dict)  # name: (value, units)
     overrides: list = field(default_factory=list)
@@ -473,7 +516,8 @@ def _regular_file(path: str | Path) -> None:
         raise ResultsFileError(f"{path}: not a regular file (a FIFO, device or socket); expected an HDF5 results file")
 
 
-def _dataset(f, path: str, ndim: Optional[int] = None, numeric: bool = True, shape: Optional[tuple] = None):
+def _dataset(f, path: str, ndim: Optional[int] = None, numeric: bool = True, shape: Optional[tuple] = None,
+             allow_nan: bool = False):
     obj = f.get(path)
     if obj is None:
         raise _Damaged(f"/{path}: missing")
@@ -489,7 +533,7 @@ def _dataset(f, path: str, ndim: Optional[int] = None, numeric: bool = True, sha
         raise _Damaged(f"/{path}: declares {obj.size:.3g} values ({obj.size * obj.dtype.itemsize / 2**30:.1f} GiB), "
                        f"more than any results file holds")
     data = obj[()]
-    if numeric and data.dtype.kind == "f" and not np.isfinite(data).all():
+    if numeric and data.dtype.kind == "f" and not (np.isfinite(data) | (allow_nan & np.isnan(data))).all():
         raise _Damaged(f"/{path}: holds non-finite values (NaN or infinity)")
     return data
 
@@ -549,10 +593,10 @@ def _read(f, path: str, for_resume: bool) -> Results:
     ny, nx = y.size, x.size
     units: dict = {}
     hist_group = _group(f, "history")
-    expected = HISTORY if version >= "1.2" else {k: HISTORY[k] for k in HISTORY_V11}
+    expected = HISTORY if version >= "1.3" else HISTORY_V12 if version == "1.2" else HISTORY_V11
     history = {}
     for k in expected:
-        history[k] = _dataset(f, f"history/{k}", 1)
+        history[k] = _dataset(f, f"history/{k}", 1, allow_nan=k == "dissipated_energy_J")
         units[f"history/{k}"] = _text(hist_group[k].attrs.get("units", ""))
     lengths = {v.shape[0] for v in history.values()}
     if len(lengths) > 1:
@@ -561,9 +605,19 @@ def _read(f, path: str, for_resume: bool) -> Results:
     cycles = _dataset(f, "fields/cycle", 1)
     units["fields/cycle"] = "cycles"
     fields = {"cycle": cycles}
-    for k in FIELDS:
-        fields[k] = _dataset(f, f"fields/{k}", 3, shape=(cycles.size, ny, nx))
+    for k in (FIELDS if version >= "1.3" else FIELDS_V12):
+        fields[k] = _dataset(f, f"fields/{k}", 3, shape=(cycles.size, ny, nx), allow_nan=k in NAN_FIELDS)
         units[f"fields/{k}"] = _text(fl[k].attrs.get("units", ""))
+    loop = {"cycle": cycles, "displacement": np.zeros((cycles.size, 0)), "tangential_force": np.zeros((cycles.size, 0))}
+    if version >= "1.3":
+        loop["cycle"] = _dataset(f, "fretting_loop/cycle", 1, shape=(cycles.size,))
+        if not np.array_equal(loop["cycle"], cycles):
+            raise _Damaged("/fretting_loop/cycle: not the snapshot cycles of /fields")
+        for k in ("displacement", "tangential_force"):
+            loop[k] = _dataset(f, f"fretting_loop/{k}", 2, allow_nan=True)
+            if loop[k].shape[0] != cycles.size or loop[k].shape != loop["displacement"].shape:
+                raise _Damaged(f"/fretting_loop/{k}: shape {loop[k].shape} does not fit the snapshots")
+            units[f"fretting_loop/{k}"] = _text(f[f"fretting_loop/{k}"].attrs.get("units", ""))
     summary = {}
     for k, v in _group(f, "summary").attrs.items():
         k = _name(k, "/summary")
@@ -576,6 +630,10 @@ def _read(f, path: str, for_resume: bool) -> Results:
             raise _Damaged(f"/summary: {k} is not finite")
         summary[k] = v
     checkpoint = _read_checkpoint(f, (ny, nx)) if "checkpoint" in f else None
+    if for_resume and version != FORMAT_VERSION:
+        raise _Damaged(f"written in format {version}; this fretsim resumes format {FORMAT_VERSION} only (its steps "
+                       f"would lack what this version records): run the case again, or resume it with the version "
+                       f"that wrote it ({attrs.get('fretsim_version', '?')})")
     if for_resume and checkpoint is None:
         raise _Damaged("/checkpoint: missing; the run cannot be resumed (it was written before its first step)")
     choices = []
@@ -597,8 +655,8 @@ def _read(f, path: str, for_resume: bool) -> Results:
         except (ValueError, TypeError):
             raise _Damaged("/inputs: its overrides attribute is not a JSON list") from None
     return Results(path=path, attrs=attrs, case_yaml=case_yaml, x=x, y=y, history=history, fields=fields,
-                   summary=summary, units=units, checkpoint=checkpoint, choices=choices, inputs=inputs,
-                   overrides=overrides)
+                   summary=summary, units=units, checkpoint=checkpoint, fretting_loop=loop, choices=choices,
+                   inputs=inputs, overrides=overrides)
 
 
 def _read_checkpoint(f, shape: tuple) -> dict:

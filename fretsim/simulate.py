@@ -96,6 +96,7 @@ class Setup:
     coarse_gap: Optional[np.ndarray] = None
     watch_growth: bool = True  # stop when an odd-even pressure pattern grows (off only to study instability)
     per_cycle: bool = True  # implicit schemes follow the per-cycle update (φ = h + ½r), not the continuous ODE
+    gross_slip_stroke: float = float("nan")  # mm: δ_t of the unworn contact (NaN without a friction coefficient)
     notes: tuple[str, ...] = ()
 
     @property
@@ -696,4 +697,10 @@ def summarize(setup: Setup, step: Step, solves: int, wall_time: float, max_error
         "element_size_y_um": setup.grid.dy * 1e3 if not setup.grid.plane_strain else float("nan"),
         "elements_x": int(setup.grid.shape[1]),
         "elements_y": int(setup.grid.shape[0]),
+        # friction: the regime and the loop of the final state (the uniform model assumes gross slip)
+        "regime": step.cycle_result.regime,
+        "tangential_force_amplitude_N": float(step.cycle_result.force_amplitude),
+        "dissipated_energy_per_cycle_J": float(step.cycle_result.energy) * 1e-3,
+        "stick_half_width_x_mm": float(step.cycle_result.stick_half_width_x),
+        "gross_slip_stroke_um": float(setup.gross_slip_stroke) * 1e3,
     }

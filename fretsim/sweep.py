@@ -440,8 +440,10 @@ def write_table(sweep: Sweep, rows: list, outdir: Path) -> tuple[Path, Path]:
                 c.attrs["units"] = units or ""
                 c.dims[0].attach_scale(ds)
         coords = " ".join(k for k in f if k not in ("point",)) if sweep.mode != "product" else ""
+        texts = {"status", "regime"}  # the summary's words; every other output is a number
         for name, data, dtype in ([("status", [r["status"] for r in rows], text)] +
-                                  [(k, [r.get(k, float("nan")) for r in rows], float) for k in outputs]):
+                                  [(k, [r.get(k, "" if k in texts else float("nan")) for r in rows],
+                                    text if k in texts else float) for k in outputs]):
             arr = np.array(data, dtype=object if dtype is text else float).reshape(shape)
             ds = f.create_dataset(name, data=arr, dtype=text if dtype is text else None)
             for axis, scale in enumerate(dims):

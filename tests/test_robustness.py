@@ -139,10 +139,10 @@ def test_fuzzed_hostile_cases_1000(tmp_path, example):
 
 def _same_arrays(a, b):
     for name in list(FIELDS) + ["cycle"]:
-        assert np.array_equal(a.fields[name], b.fields[name]), name
+        assert np.array_equal(a.fields[name], b.fields[name], equal_nan=True), name
     for name in a.history:
         if name != "wall_time":
-            assert np.array_equal(a.history[name], b.history[name]), name
+            assert np.array_equal(a.history[name], b.history[name], equal_nan=True), name
 
 
 class _StopAt:

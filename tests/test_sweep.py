@@ -40,10 +40,10 @@ def table(outdir):
 def same_arrays(a: Path, b: Path):
     ra, rb = read_results(a), read_results(b)
     for k in FIELDS:
-        assert np.array_equal(ra.fields[k], rb.fields[k]), k
+        assert np.array_equal(ra.fields[k], rb.fields[k], equal_nan=True), k
     for k in ra.history:
         if k != "wall_time":
-            assert np.array_equal(ra.history[k], rb.history[k]), k
+            assert np.array_equal(ra.history[k], rb.history[k], equal_nan=True), k
 
 
 @pytest.mark.parametrize("text, path", [
