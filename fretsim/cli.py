@@ -175,6 +175,20 @@ class _Progress:
             self.bar = None
 
 
+def _regime(s: dict, c) -> str:
+    """The regime sentence of the summary: measured (coulomb) or assumed (uniform slip)."""
+    if c.slip == "uniform":
+        known = "" if c.friction_coefficient is None else (
+            f" (the stroke is {c.stroke / (s['gross_slip_stroke_um'] * 1e-3):.3g}× the gross-slip limit "
+            f"{s['gross_slip_stroke_um']:.3g} µm)")
+        return f"Gross slip assumed{known}."
+    where = (f"stick zone ±{s['stick_half_width_x_mm'] * 1e3:.3g} µm along x" if s["regime"] == "partial_slip"
+             else "the whole contact slides")
+    return (f"{s['regime'].replace('_', ' ').capitalize()} ({where}): tangential force amplitude "
+            f"{s['tangential_force_amplitude_N']:.4g} N, {s['dissipated_energy_per_cycle_J'] * 1e3:.4g} mJ "
+            f"dissipated per cycle.")
+
+
 def _paragraph(outcome) -> str:
     s, c, g = outcome.summary, outcome.case, outcome.setup.grid
     cells = f"{g.shape[1]} elements" if g.plane_strain else f"{g.shape[1]} × {g.shape[0]} elements"
@@ -186,15 +200,19 @@ def _paragraph(outcome) -> str:
         "adaptive": f"adaptive jumps (η {c.eta:g}, ΔN_max {c.max_jump}, ΔN_L {s['linear_jump']})",
     }[c.scheme]
     refined = f", contact on a {c.coarse_element[0] * 1e3:.3g} µm coarse grid" if c.coarse_element else ""
+    model = (f"gap model {c.gap_model}" if c.slip == "uniform" and c.stroke_model == "mid_stroke" else
+             f"{c.slip} slip, stroke {c.stroke_model.replace('_', '-')}, {c.increments} increments per half-stroke")
     text = (f"{c.name}: {s['cycles']} cycles, {c.dimension.upper()} {c.geometry.kind}, {cells} of {size}{refined}, "
-            f"gap model {c.gap_model}, solver {c.solver}, {stepping}; {s['contact_solves']} contact solves in "
+            f"{model}, solver {c.solver}, {stepping}; {s['contact_solves']} contact solves in "
             f"{s['wall_time_s']:.2f} s.")
+    text += " " + _regime(s, c)
     if s["cycles"] > 0:
         text += (f" Stationary body: centre-line wear depth {s['centre_wear_depth_stationary_um']:.3g} µm "
                  f"(max {s['max_wear_depth_stationary_um']:.3g} µm), scar width {s['scar_width_stationary_mm']:.3g} mm,"
                  f" volume {s['wear_volume_stationary_mm3']:.4g} mm³. Moving body: centre-line "
                  f"{s['centre_wear_depth_moving_um']:.3g} µm (max {s['max_wear_depth_moving_um']:.3g} µm), volume "
-                 f"{s['wear_volume_moving_mm3']:.4g} mm³. Archard volume error {s['archard_volume_error']:.1e}; "
+                 f"{s['wear_volume_moving_mm3']:.4g} mm³. Volume against its invariant "
+                 f"({outcome.setup.cycle.invariant}): {s['archard_volume_error']:.1e}; "
                  f"estimated error at the recorded states: depth {s['error_estimate_depth']:.1e}, pressure "
                  f"{s['error_estimate_pressure']:.1e} (relative).")
     else:
@@ -218,6 +236,12 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
         f"{g.shape[1]} × {g.shape[0]} elements of {g.dx * 1e3:.4g} × {g.dy * 1e3:.4g} µm"
     click.echo(f"{filled.name}: {filled.cycles} cycles, {filled.dimension.upper()} {filled.geometry.kind}, {cells}")
     click.echo(f"explicit stability limit: {setup.stability_limit:.4g} cycles (solve grid, gap model {filled.gap_model})")
+    if filled.friction_coefficient is not None:
+        d_t = setup.gross_slip_stroke
+        regime = "gross slip" if filled.stroke > d_t else "partial slip"
+        click.echo(f"regime: {regime} at the start — the stroke {filled.stroke * 1e3:.4g} µm is "
+                   f"{filled.stroke / d_t:.3g}× the gross-slip limit δ_t = {d_t * 1e3:.4g} µm (μ = "
+                   f"{filled.friction_coefficient:g}, the unworn contact)")
     from fretsim.plan import estimate_cost
     solves, seconds = estimate_cost(setup)
     click.echo(f"estimate: about {solves} contact solves, {seconds:.2g} s")

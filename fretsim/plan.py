@@ -151,8 +151,11 @@ def choose_grid(case: Case, plane: bool, sizing: Sizing) -> tuple[Choice, Choice
         return (Choice("grid.domain", case.domain, "given in the case", True),
                 Choice("grid.elements", case.elements, "given in the case", True))
     if not given_d and not given_e:
+        rule = ("the paper's convergence rule, dx = 7a/40" if "÷" not in sizing.note else
+                f"the paper's rule 7a/40, refined ({sizing.note.split(' = ')[1]}) so that the partial-slip contact's "
+                f"stick zone and slip annulus each span {PARTIAL_SLIP_ELEMENTS} elements")
         return (Choice("grid.domain", sizing.domain, "automatic: holds the estimated final scar: " + sizing.note),
-                Choice("grid.elements", sizing.elements, "automatic: the paper's convergence rule, dx = 7a/40"))
+                Choice("grid.elements", sizing.elements, "automatic: " + rule))
     if given_d:
         dx = sizing.domain[0] / sizing.elements[0]
         elements = tuple(max(1, int(round(d / dx))) | 1 for d in case.domain[:1]) + (
@@ -348,7 +351,7 @@ def estimate_cost(setup) -> tuple[int, float]:
 
 # --- prepare ----------------------------------------------------------------------------------------------------
 
-def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan]:
+def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0) -> tuple[Setup, Case, Plan]:
     """Unpack a case into arrays and numbers; fill the automatic choices into the returned case.
 
     A linear jump beyond the explicit stability limit is refused (CaseError) unless ``allow_unstable``
@@ -370,10 +373,11 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
         raise CaseError(case.source, problems)
     dimension = plan.add(choose_dimension(case, e_star))
     plane = dimension == "2d"
-    sizing = auto_grid(g, plane, case.normal_load, case.stroke, case.cycles, k_m + k_s, e_star)
+    sizing = auto_grid(g, plane, case.normal_load, case.stroke, case.cycles, k_m + k_s, e_star, refine=_refine)
     gap_probe = choose_gap_model(case, Grid.centred(3, 1, sizing.domain[0] / sizing.elements[0], 1.0, True))
     if gap_probe.value == "stroke_average":  # its wear reaches two strokes beyond the contact
-        sizing = auto_grid(g, plane, case.normal_load, case.stroke, case.cycles, k_m + k_s, e_star, strokes=2)
+        sizing = auto_grid(g, plane, case.normal_load, case.stroke, case.cycles, k_m + k_s, e_star, strokes=2,
+                           refine=_refine)
     c_domain, c_elements = choose_grid(case, plane, sizing)
     domain, elements = plan.add(c_domain), plan.add(c_elements)
     if len(domain) < (1 if plane else 2) or len(elements) < (1 if plane else 2):
@@ -458,7 +462,11 @@ def prepare(case: Case, allow_unstable: bool = False) -> tuple[Setup, Case, Plan
         tangential = tangential_operator(case, grid)
         transition = gross_slip_stroke(tangential, solve(compliance, g.separation(grid), load,
                                                          tol=case.tolerance).pressure, case.friction_coefficient)
-    slip = plan.add(choose_slip(case, transition))
+    slip = choose_slip(case, transition)
+    refine = partial_slip_refinement(case, slip.value, transition, hertz.half_width_x, grid.dx)
+    if refine > 1.0 and _refine == 1.0 and case.elements is None:
+        return prepare(case, allow_unstable, _refine=refine)  # the same case on the grid partial slip needs
+    slip = plan.add(slip)
     stroke_model = plan.add(choose_stroke(case, slip, grid))
     if slip == "coulomb" or stroke_model == "resolved":
         _check_cycle_model(case, coarse, corrections, plan)
@@ -583,6 +591,21 @@ def choose_slip(case: Case, transition: Optional[float]) -> Choice:
                                            f"δ_t = {transition * 1e3:.4g} µm, so uniform slip overestimates the "
                                            f"slip by at most δ_t/δ = {deficit:.2%}, within model.accuracy "
                                            f"{case.accuracy:.1%}")
+
+
+PARTIAL_SLIP_ELEMENTS = 4  # across the stick zone and across the slip annulus, at least (as across a contact)
+
+
+def partial_slip_refinement(case: Case, slip: str, transition: Optional[float], half_width: float, dx: float) -> float:
+    """How much finer than 7a/40 the elements must be for a partial-slip contact: its stick zone and its slip
+    annulus each need PARTIAL_SLIP_ELEMENTS, or the wear step at the stick edge lives within an element or two.
+    c/a ≈ √(1 − δ/δ_t): exact for a ball (Mindlin: δ/δ_t = 1 − (1 − Q/μP)^{2/3}, c/a = (1 − Q/μP)^{1/3}), and
+    for a line contact to within the datum's term, which is linear in Q."""
+    if slip != "coulomb" or transition is None or not case.stroke < transition:
+        return 1.0
+    c = half_width * math.sqrt(max(0.0, 1.0 - case.stroke / transition))
+    narrowest = min(c, half_width - c)
+    return max(1.0, PARTIAL_SLIP_ELEMENTS * dx / max(narrowest, 1e-3 * half_width))
 
 
 def choose_stroke(case: Case, slip: str, grid: Grid) -> Choice:

@@ -88,6 +88,8 @@ def _builders(res: Results, log_cycles: bool) -> dict:
         out["history"] = lambda: _history(res, log_cycles)
     if res.y.size > 1:
         out["maps"] = lambda: _maps(res)
+    if res.fretting_loop.get("displacement") is not None and res.fretting_loop["displacement"].size:
+        out["fretting"] = lambda: _fretting(res)
     return out
 
 
@@ -107,7 +109,7 @@ def figures(res: Results, log_cycles: bool = False, names=None) -> dict:
 
 
 # figures drawn by the forked helper: together about as long to render as the others (measured on a 3D file)
-_FORKED = ("wear_profiles", "maps")
+_FORKED = ("wear_profiles", "maps", "fretting")
 
 
 def plot_all(res: Results, outdir: str | Path, fmt: str = "png", dpi: int = 150, log_cycles: bool = False,
@@ -283,7 +285,15 @@ def _history(res: Results, log_cycles: bool):
                                       STYLES):
         line, = ax.plot(n, h[name], ls=ls, marker="o", ms=2.5, lw=1.3, label=label)
         k, load, stroke = _float(res, key), _float(res, "normal_load"), _float(res, "stroke")
-        if None not in (k, load, stroke):
+        energy_law = _input(res, "wear_law") == "energy"
+        if energy_law:
+            k = _float(res, key.replace("wear_coefficient", "energy_wear_coefficient"))
+            k = None if k is None else k * 1e-3  # mm³/J → mm³/(N·mm)
+        work = h.get("wear_work")
+        if k is not None and work is not None and np.isfinite(work).all() and _input(res, "slip_model") == "coulomb":
+            ax.plot(n, k * work, color=line.get_color(), lw=0.8, alpha=0.6, ls=(0, (1, 2)),
+                    label=f"{'α·ΣW' if energy_law else 'k·Σp|ds|A'}, {label}")
+        elif None not in (k, load, stroke) and not energy_law:
             archard = k * load * 4 * stroke * 1e-3 * n
             ax.plot(n, archard, color=line.get_color(), lw=0.8, alpha=0.6, ls=(0, (1, 2)),
                     label=f"Archard k·P·4δ·N, {label}")
@@ -301,7 +311,57 @@ def _history(res: Results, log_cycles: bool):
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
     axes[0].set_title("maximum wear depth (a marker per contact solve)")
-    axes[1].set_title("wear volume against Archard's law")
+    axes[1].set_title("wear volume against its invariant")
+    return fig
+
+
+def _fretting(res: Results):
+    """The fretting loop at each snapshot, the slip distance per cycle of both bodies across the contact, and
+    where the contact sticks: the shear traction against μp along y = 0 (2D) or the moving body's slip map (3D)."""
+    loop = res.fretting_loop
+    cycles = loop["cycle"]
+    three_d = res.y.size > 1
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.4))
+    ax = axes[0]
+    for k, c in enumerate(cycles):
+        u, q = loop["displacement"][k], loop["tangential_force"][k]
+        ok = np.isfinite(u) & np.isfinite(q)
+        ax.plot(u[ok], q[ok], ls=STYLES[k % len(STYLES)], marker=".", ms=3, lw=1.2, label=_cycles_label(c))
+    ax.set_xlabel(f"applied displacement ({_unit(res, 'fretting_loop/displacement')})")
+    ax.set_ylabel(f"tangential force Q ({_unit(res, 'fretting_loop/tangential_force')})")
+    ax.set_title("fretting loop")
+    ax.legend(fontsize=8)
+    ax = axes[1]
+    last = len(res.fields["cycle"]) - 1
+    unit = _unit(res, "fields/slip_distance_moving")
+    for body, ls in (("moving", "-"), ("stationary", "--")):
+        ax.plot(res.x, centre_row(res.fields[f"slip_distance_{body}"][last]), ls=ls, lw=1.3, label=f"{body} body")
+    stroke = _float(res, "stroke")
+    if stroke is not None:
+        ax.axhline(4 * stroke, color="k", lw=0.8, ls=":", label="4δ (uniform slip)")
+    ax.set_xlabel("x, sliding direction (mm)")
+    ax.set_ylabel(f"slip distance per cycle ({unit})")
+    ax.set_title(f"slip, y = 0, {_cycles_label(res.fields['cycle'][last])}")
+    ax.legend(fontsize=8)
+    ax = axes[2]
+    if three_d:
+        slip = res.fields["slip_distance_moving"][last]
+        pc = ax.pcolormesh(res.x, res.y, np.ma.masked_where(res.fields["pressure"][last] <= 0, slip), shading="nearest",
+                           cmap="viridis")
+        fig.colorbar(pc, ax=ax, label=f"slip per cycle ({unit}); 0 = stuck")
+        ax.set_ylabel("y (mm)")
+        ax.set_title("stick and slip on the moving body")
+    else:
+        mu = _float(res, "friction_coefficient")
+        ax.plot(res.x, centre_row(res.fields["shear_traction"][last]), lw=1.3, label="|q| amplitude")
+        if mu is not None:
+            ax.plot(res.x, mu * centre_row(res.fields["pressure"][last]), "k:", lw=1.0, label="μp (slip where reached)")
+        ax.set_ylabel(f"shear traction ({_unit(res, 'fields/shear_traction')})")
+        ax.set_title("stick (|q| < μp) and slip")
+        ax.legend(fontsize=8)
+    for ax in axes:
+        ax.grid(alpha=0.3)
+    axes[2].set_xlabel("x, sliding direction (mm)")
     return fig
 
 

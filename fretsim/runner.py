@@ -70,7 +70,11 @@ def inputs_of(case: Case) -> dict:
         m = getattr(case, body)
         values[f"{body}_youngs_modulus"] = (m.youngs_modulus / 1e3, "GPa", f"Young's modulus, {body} body")
         values[f"{body}_poissons_ratio"] = (m.poissons_ratio, "1", f"Poisson's ratio, {body} body")
-        values[f"{body}_wear_coefficient"] = (m.wear_coefficient, "1/MPa", f"wear coefficient, {body} body")
+        if m.wear_coefficient is not None:
+            values[f"{body}_wear_coefficient"] = (m.wear_coefficient, "1/MPa", f"wear coefficient, {body} body")
+        if m.energy_wear_coefficient is not None:
+            values[f"{body}_energy_wear_coefficient"] = (m.energy_wear_coefficient * 1e3, "mm^3/J",
+                                                          f"energy wear coefficient, {body} body")
     values.update({
         "normal_load": (case.normal_load, "N", "normal load"),
         "stroke": (case.stroke * 1e3, "um", "slip amplitude"),
@@ -82,9 +86,15 @@ def inputs_of(case: Case) -> dict:
         "scheme": (case.scheme, "", "cycle-jumping scheme"),
         "step_tolerance": (case.step_tolerance, "1", "target relative error (implicit schemes)"),
         "linear_jump": (case.linear_jump or 0, "cycles", "linear cycle jump"),
+        "slip_model": (case.slip, "", "the fretting cycle: uniform (gross slip assumed) or coulomb"),
+        "stroke_model": (case.stroke_model, "", "the normal contact at mid-stroke or resolved along the stroke"),
+        "wear_law": (case.wear_law, "", "archard (k·p·|ds|) or energy (α·|q|·|ds|)"),
+        "increments": (case.increments, "1", "increments per half-stroke (coulomb)"),
     })
     if case.friction_coefficient is not None:
         values["friction_coefficient"] = (case.friction_coefficient, "1", "friction coefficient")
+    if case.tangential_stiffness is not None:
+        values["tangential_stiffness"] = (case.tangential_stiffness * 1e-3, "N/um", "the rig's tangential stiffness")
     e_star = effective_modulus(case.moving.youngs_modulus, case.moving.poissons_ratio,
                                case.stationary.youngs_modulus, case.stationary.poissons_ratio)
     h = g.hertz(case.normal_load, e_star)

@@ -38,7 +38,7 @@ def _odd(n: float) -> int:
 
 
 def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float, cycles: int, k_total: float,
-              e_star: float, strokes: int = 1) -> Sizing:
+              e_star: float, strokes: int = 1, refine: float = 1.0) -> Sizing:
     """The paper's element size and a domain holding the estimated final scar (both bodies' volume), plus
     ``strokes`` stroke amplitudes along x (the flat's wear reaches one stroke beyond the contact; seen through
     the stroke average, two)."""
@@ -49,10 +49,11 @@ def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float
     # no contact is wider than the body: beyond that the run stops at the physical limit
     limits = geometry.limits
     scar_x = min(scar_x, 2 * limits.reach_x)
-    dx = 7 * a / ELEMENTS_OVER_7A
+    dx = 7 * a / ELEMENTS_OVER_7A / refine
     reach = SCAR_MARGIN * max(scar_x, a) + strokes * stroke + 3 * dx
     nx = _odd(2 * reach / dx)
-    note = (f"dx = 7a/40 = {dx * 1e3:.3g} µm (a = {a * 1e3:.3g} µm), x extent {nx * dx:.3g} mm for an estimated "
+    rule = "7a/40" if refine == 1.0 else f"7a/40 ÷ {refine:.3g}"
+    note = (f"dx = {rule} = {dx * 1e3:.3g} µm (a = {a * 1e3:.3g} µm), x extent {nx * dx:.3g} mm for an estimated "
             f"scar half-width {scar_x:.3g} mm")
     if plane_strain:
         return Sizing(a, h.half_width_y, scar_x, (nx * dx,), (nx,), note)
