@@ -242,7 +242,10 @@ class _Loop:
             op = add(op, extra)
         res = solve(op, gap, load, method=s.method, p0=guess, tol=s.tolerance)
         if not res.success:
-            raise NumericalFailure(f"the contact solve did not converge at cycle {cycle}: {res.message}", self.n)
+            hint = ("; the resolved stroke's worn profiles have kinks its pressure cannot follow (README): use "
+                    "model.stroke: mid_stroke" if getattr(self.model, "singular_pressure", False) else "")
+            raise NumericalFailure(f"the contact solve did not converge at cycle {cycle}: {res.message}{hint}",
+                                   self.n)
         if not np.isfinite(res.pressure).all():
             raise NumericalFailure(f"non-finite pressure from the {s.method} solver at cycle {cycle}", self.n)
         if (res.pressure < 0).any():
@@ -263,7 +266,8 @@ class _Loop:
         """
         try:
             return self.model.solve(self.h_m if h_m is None else h_m, self.h_s if h_s is None else h_s, self.normal,
-                                    guess, step=implicit, memory=self.memory, cycle=cycle)
+                                    guess, step=implicit, memory=self.memory, cycle=cycle,
+                                    detail=cycle in self.s.snapshots)
         except CycleError as exc:
             raise NumericalFailure(f"{exc} at cycle {cycle}", self.n) from None
 

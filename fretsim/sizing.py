@@ -61,7 +61,7 @@ def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float
         ny, ly = LINE_ROWS, geometry.line_length
     else:
         scar_y = min(scar_y, 2 * (limits.reach_y or scar_y))
-        dy = 7 * h.half_width_y / ELEMENTS_OVER_7A
+        dy = 7 * h.half_width_y / ELEMENTS_OVER_7A / refine
         ny = _odd(2 * (SCAR_MARGIN * max(scar_y, h.half_width_y) + 3 * dy) / dy)
         ly = ny * dy
     return Sizing(a, h.half_width_y, scar_x, (nx * dx, ly), (nx, ny),

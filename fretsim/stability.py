@@ -104,8 +104,8 @@ def checkerboard_signed(pressure: np.ndarray, edge: int = 3) -> float:
     """Signed amplitude of the odd-even component of the pressure along x, relative to its mean.
 
     For p_i = P_i + A(−1)^i with P smooth, r_i = (−1)^i (p_{i−1} − 2p_i + p_{i+1})/4 ≈ −A at every element,
-    while the smooth part and isolated features such as edge peaks give r of no consistent sign, which
-    averages out.  The contact is taken where p exceeds 5 % of the row's peak, and elements within ``edge``
+    while the smooth part and isolated features such as edge peaks give r of no consistent sign: the median over
+    the row is −A for the mode and near zero for the features.  The contact is taken where p exceeds 5 % of the row's peak, and elements within ``edge``
     of its edges are left out.  Returns the row of largest magnitude (at least 6 interior elements); its
     sign alternates from step to step when the mode oscillates.
     """
@@ -124,9 +124,11 @@ def checkerboard_signed(pressure: np.ndarray, edge: int = 3) -> float:
     rows = count >= 6
     if not rows.any():
         return 0.0
-    mean_r = (r * interior).sum(axis=1)[rows] / count[rows]
+    # the median, not the mean: an odd-even mode gives r ≈ −A at every element, while a few sharp features (the
+    # pressure peaks at a stick zone's edge, at a worn step) give large r at a few elements only
+    med_r = np.array([np.median(r[i][interior[i]]) for i in np.flatnonzero(rows)])
     mean_p = (p * interior).sum(axis=1)[rows] / count[rows]
-    amp = -mean_r / mean_p
+    amp = -med_r / mean_p
     return float(amp[np.argmax(np.abs(amp))])
 
 

@@ -73,7 +73,8 @@ class FrettingCycle(Protocol):
 
     def solve(self, wear_moving: np.ndarray, wear_stationary: np.ndarray, normal: Normal,
               guess: Optional[np.ndarray], step: float = 0.0, memory: Optional[dict] = None,
-              cycle: int = 0) -> Cycle: ...
+              cycle: int = 0, detail: bool = True) -> Cycle:
+        """``detail``: the state will be recorded, so draw what is only drawn (the loop's shape) in full."""
 
     def stiffness(self):
         """An operator W (gap growth per cycle per unit pressure, on the solve grid) whose spectrum bounds the

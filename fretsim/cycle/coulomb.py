@@ -104,9 +104,9 @@ class CoulombCycle:
         raise NotImplementedError
 
     # -- one cycle --------------------------------------------------------------------------------------------
-    def path(self) -> list[tuple[float, float, bool]]:
+    def path(self, increments: Optional[int] = None) -> list[tuple[float, float, bool]]:
         """(U at the start, U at the end, counted) of every increment: 0 → −δ, then the loop −δ → +δ → −δ."""
-        d, n = self.stroke, self.increments
+        d, n = self.stroke, increments or self.increments
         nq = (n + 1) // 2
         quarter = [(-d * k / nq, -d * (k + 1) / nq, False) for k in range(nq)]
         up = [(-d + 2 * d * k / n, -d + 2 * d * (k + 1) / n, True) for k in range(n)]
@@ -114,9 +114,13 @@ class CoulombCycle:
         return quarter + up + down
 
     def solve(self, wear_moving, wear_stationary, normal, guess, step: float = 0.0, memory=None,
-              cycle: int = 0) -> Cycle:
+              cycle: int = 0, detail: bool = True) -> Cycle:
+        """One cycle.  With the pressure fixed (mid_stroke) a half-stroke is one monotone increment, which the
+        tangential solve takes exactly whatever its length: unless ``detail`` asks for the loop's shape (a
+        recorded state), each half-stroke is taken in one increment — the same wear, slips, energy and regime."""
         g, dx = self.grid, self.grid.dx
-        mu, n = self.friction_coefficient, self.increments
+        mu = self.friction_coefficient
+        n = self.increments if detail or self.stroke_model == "resolved" else 1
         area = g.area * self.volume_factor
         slip_lin = float((memory or {}).get("slip_lin", 4.0 * self.stroke))
         w_lin = scaled(self._w_unit, slip_lin / (4.0 * self.stroke)) if step else None
@@ -135,7 +139,7 @@ class CoulombCycle:
         first = (n + 1) // 2  # the loop's first increment (after the loading quarter)
         mid, end = first + n // 2, first + n - 1  # centred on U = 0 going up; the up-stroke's end, U = +δ
         p_prev, ds_prev, du_prev = guess, None, None
-        for k, (u0, u1, counted) in enumerate(self.path()):
+        for k, (u0, u1, counted) in enumerate(self.path(n)):
             if k == first:
                 loop_u.append(u0)
                 loop_q.append(float(q.sum()) * area)

@@ -47,7 +47,7 @@ class UniformCycle:
         return self.wear_op
 
     def solve(self, wear_moving, wear_stationary, normal, guess, step: float = 0.0, memory=None,
-              cycle: int = 0) -> Cycle:
+              cycle: int = 0, detail: bool = True) -> Cycle:
         seen = gap_wear(wear_moving, wear_stationary, self.grid.dx, self.stroke, self.gap_model)
         p, res = normal(seen, guess, scaled(self.wear_op, step) if step else None, load=self.load, cycle=cycle)
         return self._cycle(p, res)
