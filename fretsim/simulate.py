@@ -645,7 +645,7 @@ def _record(setup: Setup, cycle: int, h_m, h_s, cyc: Cycle, work: float, t0) -> 
                 wall_time=time.perf_counter() - t0, approach=res.approach, is_snapshot=cycle in setup.snapshots,
                 volume_moving=v_m, volume_stationary=v_s, archard_error=err, work=work,
                 # on the grid the contact is solved on: with refinement the fine pressure is smooth by construction
-                checkerboard=checkerboard_signed(res.pressure))
+                checkerboard=checkerboard_signed(res.pressure, stick=cyc.stick))
 
 
 def centre_line(field_2d: np.ndarray) -> np.ndarray:

@@ -19,6 +19,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import lru_cache
+from typing import Optional
 
 import numpy as np
 import scipy.linalg as sla
@@ -100,13 +101,14 @@ GROWTH_STEPS = 8  # consecutive steps of accelerating growth that make an instab
 GROWTH_FACTOR = 1.5  # ... over which the amplitude grew at least this much
 
 
-def checkerboard_signed(pressure: np.ndarray, edge: int = 3) -> float:
+def checkerboard_signed(pressure: np.ndarray, edge: int = 3, stick: Optional[np.ndarray] = None) -> float:
     """Signed amplitude of the odd-even component of the pressure along x, relative to its mean.
 
     For p_i = P_i + A(−1)^i with P smooth, r_i = (−1)^i (p_{i−1} − 2p_i + p_{i+1})/4 ≈ −A at every element,
-    while the smooth part and isolated features such as edge peaks give r of no consistent sign: the median over
-    the row is −A for the mode and near zero for the features.  The contact is taken where p exceeds 5 % of the row's peak, and elements within ``edge``
-    of its edges are left out.  Returns the row of largest magnitude (at least 6 interior elements); its
+    while the smooth part and isolated features such as edge peaks give r of no consistent sign, which
+    averages out.  The contact is taken where p exceeds 5 % of the row's peak, and elements within ``edge``
+    of its edges are left out — and, given the ``stick`` zone of a partial-slip contact, of its edges too: where
+    the wear stops at the stick zone's edge the pressure peaks, by the physics, over an element or two.  Returns the row of largest magnitude (at least 6 interior elements); its
     sign alternates from step to step when the mode oscillates.
     """
     p = np.atleast_2d(pressure)
@@ -117,6 +119,15 @@ def checkerboard_signed(pressure: np.ndarray, edge: int = 3) -> float:
     first = np.argmax(on, axis=1)[:, None]
     last = (p.shape[1] - 1 - np.argmax(on[:, ::-1], axis=1))[:, None]
     interior = (idx >= first + edge + 1) & (idx <= last - edge - 1) & on.any(axis=1, keepdims=True)
+    if stick is not None and stick.any():
+        change = np.zeros(p.shape, bool)  # an element at the stick zone's edge along x, and its neighbours
+        change[:, 1:] |= stick[:, 1:] != stick[:, :-1]
+        change[:, :-1] |= stick[:, 1:] != stick[:, :-1]
+        near = change.copy()
+        for k in range(1, edge + 1):
+            near[:, k:] |= change[:, :-k]
+            near[:, :-k] |= change[:, k:]
+        interior &= ~near
     d2 = np.zeros_like(p)
     d2[:, 1:-1] = p[:, :-2] - 2 * p[:, 1:-1] + p[:, 2:]
     r = d2 * (1.0 - 2.0 * (idx % 2)) / 4.0
@@ -124,11 +135,9 @@ def checkerboard_signed(pressure: np.ndarray, edge: int = 3) -> float:
     rows = count >= 6
     if not rows.any():
         return 0.0
-    # the median, not the mean: an odd-even mode gives r ≈ −A at every element, while a few sharp features (the
-    # pressure peaks at a stick zone's edge, at a worn step) give large r at a few elements only
-    med_r = np.array([np.median(r[i][interior[i]]) for i in np.flatnonzero(rows)])
+    mean_r = (r * interior).sum(axis=1)[rows] / count[rows]
     mean_p = (p * interior).sum(axis=1)[rows] / count[rows]
-    amp = -med_r / mean_p
+    amp = -mean_r / mean_p
     return float(amp[np.argmax(np.abs(amp))])
 
 

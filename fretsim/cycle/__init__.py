@@ -56,6 +56,7 @@ class Cycle:
     iterations: int = 0  # solver iterations over the whole cycle
     loop: Optional[tuple] = None  # (applied displacement mm, tangential force N) round the fretting loop
     memory: dict = field(default_factory=dict)  # what the member carries to its next cycle (checkpointed)
+    stick: Optional[np.ndarray] = None  # elements that stuck through the end of the up-stroke (partial slip)
     defect: float = 0.0  # implicit steps: |wear the solve anticipated − wear found| at the deepest element (mm)
 
 

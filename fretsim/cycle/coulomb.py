@@ -198,7 +198,8 @@ class CoulombCycle:
             regime="partial_slip" if stick_end.any() else "gross_slip",
             stick_half_width_x=stick_half_width(stick_end[shape[0] // 2], g.x, dx), contact=res_mid,
             iterations=iterations, loop=(np.array(loop_u), np.array(loop_q)),
-            memory={"slip_lin": max(s_mean, 0.5 * s_max, 1e-300)}, defect=defect)
+            memory={"slip_lin": max(s_mean, 0.5 * s_max, 1e-300)}, defect=defect,
+            stick=stick_end if stick_end.any() else None)
 
     def _tangential(self, q, p, du):
         """One increment's traction, slip and stick set; rigid bodies (``slip: uniform``) slide with the rig."""
