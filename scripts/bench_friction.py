@@ -1,0 +1,118 @@
+"""What friction costs, and what its increments buy.
+
+1. The uniform model against the previous release, side by side: ``FRETSIM_BASELINE=/path/to/old/checkout python
+   scripts/bench_friction.py`` runs McColl 185 N (3D, 18 000 cycles) with this tree and with that one in turn, in
+   fresh processes, and takes the ratio of the loop times pair by pair (skipped without the variable).
+2. The loop time of McColl 185 N at μ = 0.9 under each cycle model, 2D and 3D (medians of 3).
+3. Increments per half-stroke against accuracy: with the pressure at mid-stroke a half-stroke is one monotone
+   increment, so the wear does not depend on their number (they only draw the loop); with the stroke resolved
+   the pressure changes along it and the increments are a quadrature — the chart shows the depth error against
+   the loop time (McColl 500 N, 2D, against 65 increments).
+
+    python scripts/bench_friction.py [--quick]
+
+Prints tables; writes scripts/out/bench_friction.{txt,csv,png}.
+"""
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from _study import ROOT, Report, write_csv  # noqa: E402
+
+from fretsim.api import load_case, run  # noqa: E402
+
+OUT = ROOT / "scripts" / "out"
+MU = "loading.friction_coefficient=0.9"
+PROBE = ("import json, sys; from fretsim.api import load_case, run; "
+         "o = run(load_case(sys.argv[1], sys.argv[2:])); print(json.dumps(o.summary['wall_time_s']))")
+
+
+def loop_seconds(tree: str, case: str, overrides: list[str]) -> float:
+    env = dict(os.environ, PYTHONPATH=tree)
+    out = subprocess.run([sys.executable, "-c", PROBE, case, *overrides], env=env, capture_output=True, text=True,
+                         check=True)
+    return float(json.loads(out.stdout.strip().splitlines()[-1]))
+
+
+def main(quick: bool = False) -> None:
+    say = Report()
+    rows = []
+    case = str(ROOT / "cases" / "mccoll_185N.yaml")
+    baseline = os.environ.get("FRETSIM_BASELINE")
+    if baseline:
+        pairs = 3 if quick else 7
+        ratios, a_s, b_s = [], [], []
+        for _ in range(pairs):
+            a, b = loop_seconds(str(ROOT), case, []), loop_seconds(baseline, case, [])
+            a_s.append(a), b_s.append(b), ratios.append(a / b)
+        say(f"uniform model, McColl 185 N 3D, loop: this tree {np.median(a_s):.3f} s, {baseline} {np.median(b_s):.3f} s;"
+            f" ratio per pair median {np.median(ratios):.3f} (min {min(ratios):.3f}, max {max(ratios):.3f}), {pairs} pairs")
+        rows.append({"what": "uniform vs baseline", "ratio_median": float(np.median(ratios))})
+    say("")
+    say("McColl 185 N, μ = 0.9, 18 000 cycles: loop time (s, median of 3) and the flat's centre-line depth")
+    say(f"{'model':<28}{'dim':<5}{'loop s':>9}{'solves':>8}{'depth µm':>10}  status")
+    for label, model in (("uniform", ["model.slip=uniform"]), ("coulomb (mid-stroke)", ["model.slip=coulomb"]),
+                         ("coulomb, stroke resolved", ["model.slip=coulomb", "model.stroke=resolved"])):
+        for dim in ("2d", "3d"):
+            times, last = [], None
+            for _ in range(1 if quick or "resolved" in label else 3):
+                last = run(load_case(case, [MU, f"model.dimension={dim}", *model]))
+                times.append(last.summary["wall_time_s"])
+            s = last.summary
+            say(f"{label:<28}{dim:<5}{np.median(times):>9.2f}{s['contact_solves']:>8}"
+                f"{s['centre_wear_depth_stationary_um']:>10.4f}  {last.status} {last.message[:60]}")
+            rows.append({"what": label, "dimension": dim, "loop_s": float(np.median(times)),
+                         "solves": s["contact_solves"], "depth_um": s["centre_wear_depth_stationary_um"],
+                         "status": last.status})
+    say("")
+    say("increments per half-stroke against the depth error (against 65) and the loop time, 2D")
+    chart = {}
+    for label, name, model in (("mid-stroke, McColl 185 N", "mccoll_185N", ["model.slip=coulomb"]),
+                               ("resolved, McColl 500 N", "mccoll_500N", ["model.slip=coulomb",
+                                                                           "model.stroke=resolved"])):
+        points = []
+        ref = None
+        for n in (65, 33, 17, 9, 5, 3, 1) if not quick else (17, 5, 1):
+            o = run(load_case(str(ROOT / "cases" / f"{name}.yaml"), [MU, "model.dimension=2d", *model,
+                                                                      f"model.increments={n}"]))
+            s = o.summary
+            ref = ref or s
+            err = max(abs(s[k] / ref[k] - 1) for k in ("centre_wear_depth_stationary_um", "max_wear_depth_moving_um"))
+            points.append((n, s["wall_time_s"], err))
+            say(f"  {label:<26} n = {n:>3}: loop {s['wall_time_s']:7.2f} s, depth error {err:.2e}  {o.status}")
+            rows.append({"what": f"increments, {label}", "increments": n, "loop_s": s["wall_time_s"],
+                         "depth_error": err, "status": o.status})
+        chart[label] = points
+    OUT.mkdir(parents=True, exist_ok=True)
+    say.write(OUT / "bench_friction.txt")
+    write_csv(rows, OUT / "bench_friction.csv")
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    fig, ax = plt.subplots(figsize=(6.5, 4.5))
+    for label, points in chart.items():
+        n, t, e = zip(*points[1:])
+        ax.plot(t, np.maximum(e, 1e-16), "o-", label=label)
+        for ni, ti, ei in zip(n, t, e):
+            ax.annotate(str(ni), (ti, max(ei, 1e-16)), fontsize=7, xytext=(3, 3), textcoords="offset points")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("loop time (s)")
+    ax.set_ylabel("depth error against 65 increments")
+    ax.set_title("increments per half-stroke (labels): cost against accuracy, 2D")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8)
+    fig.tight_layout()
+    fig.savefig(OUT / "bench_friction.png", dpi=130)
+    print(f"wrote {OUT / 'bench_friction.txt'}, .csv, .png")
+
+
+if __name__ == "__main__":
+    main("--quick" in sys.argv)
