@@ -14,7 +14,8 @@ def _col(name: str, units: str) -> str:
 
 
 def export_csv(res: Results, outdir: str | Path) -> list[Path]:
-    """Write history.csv, summary.csv, inputs.csv and fields.csv (long format: cycle, x, y, fields) to outdir."""
+    """Write history.csv, summary.csv, inputs.csv, fields.csv (long format: cycle, x, y, fields) and, for a
+    cycle with friction, fretting_loop.csv (cycle, displacement, force round each recorded loop) to outdir."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     paths = []
@@ -42,4 +43,12 @@ def export_csv(res: Results, outdir: str | Path) -> list[Path]:
         rows.extend(zip(*(c.tolist() for c in cols)))
     write("fields.csv", ["cycle", "x [mm]", "y [mm]"] + [_col(k, res.units.get(f"fields/{k}", "")) for k in names],
           rows)
+    loop = res.fretting_loop
+    if loop.get("displacement") is not None and loop["displacement"].size:
+        rows = [(int(c), float(u), float(q)) for c, us, qs in zip(loop["cycle"], loop["displacement"],
+                                                                   loop["tangential_force"])
+                for u, q in zip(us, qs) if np.isfinite(u) and np.isfinite(q)]
+        write("fretting_loop.csv", ["cycle", _col("displacement", res.units.get("fretting_loop/displacement", "um")),
+                                    _col("tangential_force", res.units.get("fretting_loop/tangential_force", "N"))],
+              rows)
     return paths

@@ -378,3 +378,8 @@ def test_a_coulomb_run_records_its_loop_slips_energy_and_regime(tmp_path):
     assert volume_m == pytest.approx(2e-8 * res.history["wear_work"][-1], rel=1e-12)
     assert "fretting" in figures(res)
     assert out.summary["regime"] == s["regime"]
+    from fretsim.export import export_csv
+    names = [p.name for p in export_csv(res, tmp_path / "csv")]
+    assert "fretting_loop.csv" in names
+    rows = (tmp_path / "csv" / "fretting_loop.csv").read_text().splitlines()
+    assert rows[0] == "cycle,displacement [um],tangential_force [N]" and len(rows) == 1 + 2 * 19
