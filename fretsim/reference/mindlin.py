@@ -86,6 +86,19 @@ def cylinder_traction(x: np.ndarray, q: float, mu: float, load_per_length: float
     return outer - inner
 
 
+def cylinder_displacement(q: float, mu: float, load_per_length: float, half_width: float, e_star: float,
+                          datum: float) -> float:
+    """δ(Q′) of a monotonic loading, the displacement measured from surface points at distance ``datum``: the
+    stick zone moves as a whole by (μp₀/E*)·[a(ln(2d/a) + ½) − (c²/a)(ln(2d/c) + ½)] (an elliptic traction
+    q₀√(1 − x²/b²) displaces its centre by (q₀b/E*)(ln(2d/b) + ½) against the datum, its curvature terms cancel
+    in the stick zone).  The datum enters only as the term (2μP′/πE*)·t·ln d linear in t = Q′/μP′."""
+    t = _t(q, mu * load_per_length)
+    p0 = 2.0 * load_per_length / (math.pi * half_width)
+    c2 = half_width**2 * (1.0 - t)
+    inner = c2 / half_width * (math.log(2.0 * datum / math.sqrt(c2)) + 0.5) if c2 > 0 else 0.0
+    return mu * p0 / e_star * (half_width * (math.log(2.0 * datum / half_width) + 0.5) - inner)
+
+
 def cylinder_loop_energy(q_amplitude: float, mu: float, load_per_length: float, e_star: float) -> float:
     """Energy dissipated per cycle per unit length (N·mm/mm) between ±Q′* — independent of the 2D datum."""
     t = _t(q_amplitude, mu * load_per_length)
