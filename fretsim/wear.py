@@ -184,19 +184,3 @@ def sweep_read(field: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float,
     for target, share, inside in _sweep_shares(start, end, dx, kernel):
         out += np.where(inside, field[rows, np.clip(target, 0, nx - 1)] * share, 0.0)
     return out
-
-
-def read_shifted(field: np.ndarray, shift: np.ndarray, dx: float) -> np.ndarray:
-    """``field`` (on the flat) read at x_j + shift[j] for each element j: linear between element centres along x,
-    0 beyond the grid (the flat is unworn there).  The gap a moving point sees over the worn flat."""
-    ny, nx = field.shape
-    pos = np.arange(nx)[None, :] + shift / dx
-    i0 = np.floor(pos).astype(int)
-    w = pos - i0
-    rows = np.arange(ny)[:, None]
-
-    def at(i):
-        ok = (i >= 0) & (i < nx)
-        return np.where(ok, field[rows, np.clip(i, 0, nx - 1)], 0.0)
-
-    return (1.0 - w) * at(i0) + w * at(i0 + 1)

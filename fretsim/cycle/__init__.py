@@ -85,6 +85,8 @@ class FrettingCycle(Protocol):
         """(moving, stationary) wear volumes (mm³) the invariant demands after ``cycles`` with accumulated
         ``work``."""
 
+    # a linear member also rebuilds the cycle of a checkpoint's pressure without solving: restore(pressure)
+
 
 def stick_half_width(stick_row: np.ndarray, x: np.ndarray, dx: float) -> float:
     """Half the length along x of the stick zone in one row (0 if none): the stuck elements' extent, centre to

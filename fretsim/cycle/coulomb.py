@@ -44,10 +44,8 @@ from fretsim.grid import Grid
 from fretsim.solvers.tangential import solve_tangential
 from fretsim.wear import gap_wear, sweep_deposit, sweep_read, wear_operator
 
-POSITION_TOLERANCE = 0.05  # of an element: a resolved increment is solved again if a point's predicted mid-increment
-#                            position was off by more (the pressure follows the worn flat on that scale)
-LAWS = ("archard", "energy")
-STROKE_MODELS = ("mid_stroke", "resolved")
+TRAVEL_TOLERANCE = 0.1  # of an element: a resolved increment is solved again where a point's predicted travel was off
+#                         by more (the pressure follows the worn flat on that scale)
 
 
 @dataclass(frozen=True)
@@ -99,9 +97,6 @@ class CoulombCycle:
 
     def expected_volumes(self, cycles: int, work: float) -> tuple[float, float]:
         return self.k_moving * work, self.k_stationary * work
-
-    def restore(self, pressure):  # pragma: no cover - the loop re-solves a non-linear member instead
-        raise NotImplementedError
 
     # -- one cycle --------------------------------------------------------------------------------------------
     def path(self, increments: Optional[int] = None) -> list[tuple[float, float, bool]]:
@@ -156,7 +151,7 @@ class CoulombCycle:
             iterations += its
             if resolved and self.slip == "coulomb":
                 off = np.abs(ds - ds_guess)[p > 0]
-                if off.size and off.max() > 2 * POSITION_TOLERANCE * dx:  # solve again where the points really went
+                if off.size and off.max() > TRAVEL_TOLERANCE * dx:  # solve again where the points really went
                     ds_guess = ds
                     p, res = normal(wear_moving + sweep_read(wear_stationary, s, s + ds, dx, self.kernel), p, extra,
                                     load=self.load, cycle=cycle)
