@@ -143,7 +143,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
                     "auto", choices=SLIP_MODELS),
         "stroke": Key("choice", "the normal contact at mid-stroke only (mid_stroke, the paper) or at each increment "
                                 "of the cycle with the moving body where it is over the worn flat (resolved); "
-                                "auto: mid_stroke for uniform slip, resolved for coulomb", "auto",
+                                "auto: mid_stroke (the resolved stroke's worn profiles kink at the contact's turning edges: "
+                                "README), resolved only when asked; resolved needs loading.friction_coefficient",
+                      "auto",
                       choices=STROKE_MODELS),
         "wear_law": Key("choice", "archard (dh = k·p·|ds|) or energy (dh = α·|q|·|ds|, Fouvry; needs "
                                   "materials.*.energy_wear_coefficient and loading.friction_coefficient)",
@@ -682,8 +684,11 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
         if getattr(m, key) is None:
             r.fail(f"materials.{body}.{key}", f"missing; model.wear_law {law} needs it, e.g. "
                                               f"'{_example(key)}'")
-    if mu is None and (slip == "coulomb" or law == "energy"):
-        why = "model.slip coulomb" if slip == "coulomb" else "model.wear_law energy (dh = α·|q|·|ds|, |q| = μp)"
+    stroke_model = model.get("stroke")
+    if mu is None and (slip == "coulomb" or law == "energy" or stroke_model == "resolved"):
+        why = ("model.slip coulomb" if slip == "coulomb" else
+               "model.wear_law energy (dh = α·|q|·|ds|, |q| = μp)" if law == "energy" else
+               "model.stroke resolved (the shear traction μp it reports at each increment)")
         r.fail("loading.friction_coefficient", f"missing; {why} needs it, e.g. 0.9")
     if model.get("increments") is not None and model["increments"] % 2 == 0:
         r.fail("model.increments", f"{model['increments']} is even; expected an odd number, so that one increment "

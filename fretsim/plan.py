@@ -50,7 +50,8 @@ class Plan:
     warnings: list = field(default_factory=list)
 
     def add(self, choice: Choice) -> Any:
-        self.choices.append(choice)
+        """Record a choice; a later choice for the same key replaces the earlier one (one line per key)."""
+        self.choices = [c for c in self.choices if c.key != choice.key] + [choice]
         return choice.value
 
 
@@ -152,8 +153,10 @@ def choose_grid(case: Case, plane: bool, sizing: Sizing) -> tuple[Choice, Choice
                 Choice("grid.elements", case.elements, "given in the case", True))
     if not given_d and not given_e:
         rule = ("the paper's convergence rule, dx = 7a/40" if "÷" not in sizing.note else
-                f"the paper's rule 7a/40, refined ({sizing.note.split(' = ')[1]}) so that the partial-slip contact's "
-                f"stick zone and slip annulus each span {PARTIAL_SLIP_ELEMENTS} elements")
+                f"the paper's rule 7a/40, refined ({sizing.note.split(' = ')[1]}) for partial slip: its stick zone "
+                f"and slip annulus span {PARTIAL_SLIP_ELEMENTS} elements each (up to {TRANSITION_BAND:g} δ_t, where "
+                f"a worn contact may come to stick, {2 * PARTIAL_SLIP_ELEMENTS} across the half-width; at most "
+                f"{MAX_PARTIAL_SLIP_REFINEMENT:g}× per axis)")
         return (Choice("grid.domain", sizing.domain, "automatic: holds the estimated final scar: " + sizing.note),
                 Choice("grid.elements", sizing.elements, "automatic: " + rule))
     if given_d:
@@ -413,7 +416,8 @@ def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0) -> t
     if need > MEMORY_SHARE * available_memory():
         problems.append(("grid", f"the grid of {nx} x {ny} elements{' (automatic)' if case.elements is None else ''}"
                                  f"{f' solved on {coarse_n} coarse elements' if coarse_n else ''} with solver "
-                                 f"{case.solver} would need about {need / 2**30:.1f} GiB, more than "
+                                 f"{case.solver}{f' (refined {_refine:.3g}× per axis for the partial-slip contact)' if _refine > 1 else ''}"
+                                 f" would need about {need / 2**30:.1f} GiB, more than "
                                  f"{MEMORY_SHARE:.0%} of this machine's {available_memory() / 2**30:.0f} GiB; "
                                  f"coarsen the grid, shorten the run, or check the case's units"))
     if problems:
@@ -476,11 +480,21 @@ def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0) -> t
     slip = choose_slip(case, transition)
     refine = partial_slip_refinement(case, slip.value, transition, hertz.half_width_x, grid.dx)
     if refine > 1.0 and _refine == 1.0 and case.elements is None:
-        return prepare(case, allow_unstable, _refine=refine)  # the same case on the grid partial slip needs
+        # the same case on the grid partial slip needs, within a cap: a tiny stroke's annulus would need thousands
+        return prepare(case, allow_unstable, _refine=min(refine, MAX_PARTIAL_SLIP_REFINEMENT))
+    if refine > 1.01:  # short of the target beyond round-off
+        width = PARTIAL_SLIP_ELEMENTS * grid.dx / refine
+        plan.warnings.append(f"partial slip: the narrower of the stick zone and the slip annulus (about "
+                             f"{width * 1e3:.3g} µm along x) spans {PARTIAL_SLIP_ELEMENTS / refine:.2g} elements of "
+                             f"{grid.dx * 1e3:.3g} µm, fewer than the {PARTIAL_SLIP_ELEMENTS} it needs"
+                             + (f" (the automatic grid is refined at most {MAX_PARTIAL_SLIP_REFINEMENT:g}× per axis)"
+                                if case.elements is None else " (grid.elements is given)")
+                             + ": the wear step at the stick edge and the depths in the annulus are grid-limited; "
+                               "give a finer grid.elements to resolve them")
     slip = plan.add(slip)
     stroke_model = plan.add(choose_stroke(case, slip, grid))
     if slip == "coulomb" or stroke_model == "resolved":
-        _check_cycle_model(case, coarse, corrections, plan)
+        _check_cycle_model(case, coarse, corrections, plan, transition)
         if stroke_model == "resolved":
             plan.add(Choice("model.gap", case.gap_model, "not used: the stroke is resolved, each position sees the "
                                                          "flat's wear under it", case.gap_model != "auto"))
@@ -488,6 +502,11 @@ def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0) -> t
                                  "turn at the stroke's ends, with pressure peaks there that grow as the grid is "
                                  "refined (the depths and widths settle; the peak pressure does not), and the "
                                  "depths move with the step size by a few per cent (README: the resolved stroke)")
+            if case.increments < 5:
+                plan.warnings.append(f"model.increments {case.increments} with the stroke resolved: the contact "
+                                     f"is solved at only {case.increments} position(s) per half-stroke, so each "
+                                     f"point's travel over the worn flat is sampled coarsely (the default 9 agrees "
+                                     f"with 65 to 0.6 % in depth: README)")
     spectrum = wear_spectrum(solve_op, case.stroke, k_m, k_s, "resolved" if stroke_model == "resolved" else gap_model)
     limit = spectrum.limit
     _check_model_growth(case, gap_model, spectrum, plan)
@@ -605,6 +624,8 @@ def choose_slip(case: Case, transition: Optional[float]) -> Choice:
 
 
 PARTIAL_SLIP_ELEMENTS = 4  # across the stick zone and across the slip annulus, at least (as across a contact)
+TRANSITION_BAND = 2.0  # strokes up to this many δ_t are refined as partial slip is: the worn contact may stick
+MAX_PARTIAL_SLIP_REFINEMENT = 3.0  # per axis (9× the elements in 3D): beyond, the user is told and refines by hand
 
 
 def partial_slip_refinement(case: Case, slip: str, transition: Optional[float], half_width: float, dx: float) -> float:
@@ -612,10 +633,16 @@ def partial_slip_refinement(case: Case, slip: str, transition: Optional[float], 
     annulus each need PARTIAL_SLIP_ELEMENTS, or the wear step at the stick edge lives within an element or two.
     c/a ≈ √(1 − δ/δ_t): exact for a ball (Mindlin: δ/δ_t = 1 − (1 − Q/μP)^{2/3}, c/a = (1 − Q/μP)^{1/3}), and
     for a line contact to within the datum's term, which is linear in Q."""
-    if slip != "coulomb" or transition is None or not case.stroke < transition:
+    if slip != "coulomb" or transition is None or not case.stroke < TRANSITION_BAND * transition:
         return 1.0
-    c = half_width * math.sqrt(max(0.0, 1.0 - case.stroke / transition))
-    narrowest = min(c, half_width - c)
+    if case.stroke >= transition:
+        # gross slip at the start, but a worn centre stops sliding as its pressure grows (more pressure, less slip,
+        # less wear): a stick zone forms and its edge feeds back on the wear.  At 7a/40 that feedback grew an
+        # element-scale pattern (1.12 δ_t, the per-cycle run too); 8 elements across the half-width settle it
+        narrowest = half_width / 2
+    else:
+        c = half_width * math.sqrt(max(0.0, 1.0 - case.stroke / transition))
+        narrowest = min(c, half_width - c)
     return max(1.0, PARTIAL_SLIP_ELEMENTS * dx / max(narrowest, 1e-3 * half_width))
 
 
@@ -632,12 +659,16 @@ def choose_stroke(case: Case, slip: str, grid: Grid) -> Choice:
                                                 "stroke's ends: README)")
 
 
-def _check_cycle_model(case: Case, coarse, corrections, plan: Plan) -> None:
+def _check_cycle_model(case: Case, coarse, corrections, plan: Plan, transition: Optional[float]) -> None:
     """What the incremental cycle does not do, refused or said."""
     if coarse is not None:
+        partial = transition is not None and case.stroke <= transition
         raise CaseError(case.source, [("grid.coarse_element", "grid refinement (Eqs. 11-12) applies to the "
                                                               "uniform-slip model at mid-stroke only; remove "
-                                                              "grid.coarse_element, or use model.slip: uniform")])
+                                                              "grid.coarse_element" + (
+                                                                  " (this stroke is in partial slip, where uniform "
+                                                                  "slip is refused)" if partial else
+                                                                  ", or use model.slip: uniform"))])
     from fretsim.reference.mindlin import dundurs_beta
     beta = dundurs_beta(case.moving.youngs_modulus, case.moving.poissons_ratio, case.stationary.youngs_modulus,
                         case.stationary.poissons_ratio)

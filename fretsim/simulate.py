@@ -287,11 +287,17 @@ class _Loop:
         if step.archard_error > ARCHARD_ROUND_OFF:
             raise NumericalFailure(f"the wear invariant is broken at cycle {self.n}: the wear volume differs from "
                                    f"{self.model.invariant} by {step.archard_error:.2e} (relative)", self.n)
+        _check_bounds(self.model, cyc, self.work, self.n)
         if self.n > 0 and self.watch.update(step.checkerboard) and s.watch_growth:
             if s.scheme in ("linear", "adaptive"):
                 cause = (f"the {'linear jump ' + str(s.linear_jump) + ' cycles' if s.scheme == 'linear' else 'adaptive jumps'}"
                          f" are unstable on this grid (explicit stability limit {s.stability_limit:.4g} cycles). Use "
                          f"jumping.scheme: bdf2 (no stability limit), or a smaller jumping.linear")
+            elif not getattr(self.model, "linear", True):
+                cause = (f"the implicit steps have no stability limit, so the {self.model.name} cycle itself grew it: "
+                         f"where the contact partly sticks, more pressure means less slip and less wear, and on a "
+                         f"coarse grid that feedback grows at the stick zone's edge (the per-cycle run does it too). "
+                         f"Refine the grid (grid.elements) so that the contact's half-width spans more elements")
             else:
                 cause = (f"the implicit steps have no stability limit, so the model itself is unstable here (explicit "
                          f"limit {s.stability_limit:.4g} cycles, gap model {getattr(self.model, 'gap_model', '–')}): "
@@ -628,6 +634,26 @@ def _check_edges(p: np.ndarray, band: int, grid: Grid, cycle: int, setup: Setup)
         raise DomainError(f"the contact reached the {'x' if hit_x else 'y'} edge of the grid at cycle {cycle} "
                           f"(extent {extent:.4g} mm): enlarge grid.domain, or leave grid empty for automatic "
                           f"sizing", cycle)
+
+
+BOUND_ROUND_OFF = 1e-6  # the tangential solve's slip is exact to ~1e-10 of the stroke; a cycle beyond its physical
+#                         bound by more than this is a fault, not round-off
+
+
+def _check_bounds(model, cyc: Cycle, work: float, cycle: int) -> None:
+    """The cycle's work and energy, and the work accumulated to ``cycle``, within what the physics allows."""
+    w_max, e_max = model.bounds
+    top = 1.0 + BOUND_ROUND_OFF
+    what = None
+    if not (0.0 <= cyc.work <= w_max * top):
+        what = f"the cycle's wear work {cyc.work:.6g} N·mm lies outside [0, {w_max:.6g}] (no point slides further " \
+               f"than the rig travels, 4δ)"
+    elif np.isfinite(cyc.energy) and not (0.0 <= cyc.energy <= e_max * top):
+        what = f"the dissipated energy per cycle {cyc.energy:.6g} N·mm lies outside [0, μ·P·4δ = {e_max:.6g}]"
+    elif not (0.0 <= work <= w_max * max(cycle, 1) * top):
+        what = f"the accumulated wear work {work:.6g} N·mm lies outside [0, {w_max * cycle:.6g}] ({cycle} cycles)"
+    if what:
+        raise NumericalFailure(f"a physical bound is broken at cycle {cycle}: {what}", cycle)
 
 
 def _record(setup: Setup, cycle: int, h_m, h_s, cyc: Cycle, work: float, t0) -> Step:

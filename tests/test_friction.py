@@ -240,15 +240,21 @@ def test_a_long_cylinder_takes_up_the_stroke_in_2d_as_in_3d():
     a = math.sqrt(4 * load / length * radius / (math.pi * E_STAR))
     dx = 7 * a / 40
     g2 = Grid.centred(61, 1, dx, 1.0, plane_strain=True)
-    g3 = Grid.centred(61, 41, dx, length / 41)
     out = []
-    for g, lf in ((g2, load / length), (g3, load)):
+    for g, lf in ((g2, load / length), (Grid.centred(61, 21, dx, length / 21), load),
+                  (Grid.centred(61, 81, dx, length / 81), load)):
         x, y = g.mesh()
         gap = x**2 / (2 * radius) if g.plane_strain else np.where(np.abs(y) <= length / 2, x**2 / (2 * radius), np.inf)
         p = solve(HalfSpace(g, E_STAR), gap, lf, tol=1e-12).pressure
         k = Tangential(g, BODIES, line_length=length if g.plane_strain else None)
         out.append(gross_slip_stroke(k, p, 0.9))
-    assert out[0] == pytest.approx(out[1], rel=0.05)  # a finite 3D line's ends take up a little less
+    # δ_t is read on the centre section, which the 2D model is of: measured 0.7 % (21 rows) and 1.1 % (81 rows)
+    # below 2D; 2 % leaves room for the 3D value's slow drift with the rows, and a datum off by a factor e (one
+    # unit in its logarithm) would move 2D by 14 %
+    assert out[0] == pytest.approx(out[2], rel=0.02)
+    # and it is a property of the contact, not of the grid: 21 against 81 rows, measured 0.4 % (the ends' maximum,
+    # which the end effects rule, moves 1.7 %)
+    assert out[1] == pytest.approx(out[2], rel=0.01)
 
 
 # --- the models it reduces to, and the invariants ----------------------------------------------------------------
@@ -333,9 +339,74 @@ def test_every_stepping_scheme_runs_the_coulomb_cycle_and_meets_the_exact_per_cy
     assert s["contact_solves"] < 0.2 * ref["contact_solves"]
 
 
+PARTIAL_2D = ["model.dimension=2d", "loading.friction_coefficient=0.9", "loading.stroke=0.4 um", "loading.cycles=3000",
+              "output.snapshots=[0, 1000, 3000]"]
+
+
+@pytest.fixture(scope="module")
+def exact_partial_slip():
+    """The exact model in partial slip (McColl's cylinder at 0.4 µm, well below δ_t): a cycle per cycle."""
+    return _run(*PARTIAL_2D, "jumping.scheme=linear", "jumping.linear=1")
+
+
+@pytest.mark.parametrize("scheme, tolerance", [("bdf2", 1e-3), ("implicit", 5e-3), ("adaptive", 1e-2)])
+def test_partial_slip_stepping_meets_the_exact_per_cycle_run(exact_partial_slip, scheme, tolerance):
+    """The rates of a partly stuck contact are not linear in the pressure and change where the stick edge moves.
+    Measured against the per-cycle run: bdf2 2.6e-4 (the bound 1e-3 is a tenth of its tolerance), backward Euler
+    2.3e-3, the paper's adaptive jumps 4.5e-3 (first order: bounds about twice that), each with an error estimate
+    of its size (measured 0.95e-3, 2.4e-3, 8.5e-3)."""
+    out = _run(*PARTIAL_2D, f"jumping.scheme={scheme}")
+    assert out.status == "complete", out.message
+    s, ref = out.summary, exact_partial_slip.summary
+    assert s["regime"] == ref["regime"] == "partial_slip"
+    worst = max(abs(s[k] / ref[k] - 1) for k in ("max_wear_depth_stationary_um", "max_wear_depth_moving_um",
+                                                    "centre_wear_depth_stationary_um"))
+    assert worst < tolerance
+    assert s["error_estimate_depth"] >= 0.5 * worst
+    assert s["contact_solves"] < 0.02 * ref["contact_solves"]
+
+
+def test_every_cycle_keeps_within_what_the_physics_allows(exact_partial_slip):
+    """Independently of the invariant (which the loop accumulates from the cycles' own work): no point slides
+    further than the rig travels and |q| ≤ μp, so per cycle Σp|ds|A ≤ P·4δ and the energy ≤ μ·P·4δ; a partly
+    stuck contact stays well below both (its centre does not slide)."""
+    h = exact_partial_slip.summary
+    p_4delta = 185.0 * 4 * 0.4e-3  # N·mm
+    assert 0 < h["dissipated_energy_per_cycle_J"] * 1e3 < 0.5 * 0.9 * p_4delta
+    work_per_cycle = h["wear_volume_stationary_mm3"] / 2e-8 / h["cycles"]
+    assert 0 < work_per_cycle < 0.5 * p_4delta
+
+
+def test_a_cycle_beyond_its_physical_bounds_stops_the_run(monkeypatch):
+    """A slip or traction the tangential solve got wrong keeps the invariant (the volume follows the work the cycle
+    reports) but breaks the bounds: a cycle whose points slide 1.5 times the rig's travel, or dissipate more than
+    μ·P·4δ, stops the run with the reason instead of being written."""
+    import dataclasses
+    original = CoulombCycle.solve
+
+    def inflated(field, factor):
+        def solve(self, *a, **k):
+            cyc = original(self, *a, **k)
+            return dataclasses.replace(cyc, **{field: getattr(cyc, field) * factor})
+        return solve
+
+    for field in ("work", "energy"):
+        monkeypatch.setattr(CoulombCycle, "solve", inflated(field, 1.5))
+        out = _run(*COULOMB_2D, "loading.cycles=20", "output.snapshots=[0, 20]")
+        assert out.status == "failed" and "physical bound" in out.message, (field, out.status, out.message)
+    monkeypatch.setattr(CoulombCycle, "solve", inflated("work", 1.0))
+    assert _run(*COULOMB_2D, "loading.cycles=20", "output.snapshots=[0, 20]").status == "complete"
+
+
+def test_a_resolved_stroke_without_a_friction_coefficient_is_refused_naming_the_key():
+    from fretsim.api import CaseError, load_case
+    with pytest.raises(CaseError, match="loading.friction_coefficient.*model.stroke resolved"):
+        load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", "model.stroke=resolved"])
+
+
 def test_the_rig_takes_q_over_k_of_the_stroke():
     """A rig of stiffness k in series with the contact: gross slip needs μP/k more stroke (exactly: the rig's
-    compliance is a constant kernel), and the loop's elastic flank is softer by that much."""
+    compliance is a constant kernel)."""
     stiff = _run(*COULOMB_2D, "loading.cycles=0")
     soft = _run(*COULOMB_2D, "loading.cycles=0", "loading.tangential_stiffness=40 N/um")
     extra_um = 0.9 * 185.0 / 40.0  # μP/k in µm (k in N/µm)
@@ -396,3 +467,22 @@ def test_a_coulomb_run_records_its_loop_slips_energy_and_regime(tmp_path):
     assert "fretting_loop.csv" in names
     rows = (tmp_path / "csv" / "fretting_loop.csv").read_text().splitlines()
     assert rows[0] == "cycle,displacement [um],tangential_force [N]" and len(rows) == 1 + 2 * 19
+
+
+@pytest.mark.slow
+def test_the_shipped_partial_slip_ball_meets_its_per_cycle_run(tmp_path):
+    """ball_partial_slip (3D, 20 000 cycles) under the defaults against the exact per-cycle run on the same grid
+    (about 2.5 min): measured 0.15 % in the deepest point, 0.58 % in the final pressure (L2).  The stepping
+    estimate printed for it (7.5e-4) is half the depth error found: under-reported, which the error-bar issue
+    addresses; the bounds here are a few times the measured errors."""
+    import h5py
+    from fretsim.api import load_case, run
+    case = CASES / "ball_partial_slip.yaml"
+    fast = run(load_case(case, []), tmp_path / "fast.h5")
+    exact = run(load_case(case, ["jumping.scheme=linear", "jumping.linear=1"]), tmp_path / "exact.h5")
+    assert fast.status == exact.status == "complete"
+    with h5py.File(tmp_path / "fast.h5") as f, h5py.File(tmp_path / "exact.h5") as g:
+        d_f, d_g = f["fields/wear_depth_stationary"][-1], g["fields/wear_depth_stationary"][-1]
+        p_f, p_g = f["fields/pressure"][-1], g["fields/pressure"][-1]
+    assert abs(d_f.max() / d_g.max() - 1) < 5e-3
+    assert np.linalg.norm(p_f - p_g) / np.linalg.norm(p_g) < 2e-2

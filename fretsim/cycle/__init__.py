@@ -57,6 +57,7 @@ class Cycle:
     loop: Optional[tuple] = None  # (applied displacement mm, tangential force N) round the fretting loop
     memory: dict = field(default_factory=dict)  # what the member carries to its next cycle (checkpointed)
     stick: Optional[np.ndarray] = None  # elements that stuck through the end of the up-stroke (partial slip)
+    mismatch: Optional[np.ndarray] = None  # implicit steps of a non-linear member: the gap growth found − anticipated
     defect: float = 0.0  # implicit steps: |wear the solve anticipated − wear found| at the deepest element (mm)
 
 
@@ -80,6 +81,11 @@ class FrettingCycle(Protocol):
     def stiffness(self):
         """An operator W (gap growth per cycle per unit pressure, on the solve grid) whose spectrum bounds the
         member's: it sets the explicit stability limit and is what an implicit step folds into the compliance."""
+
+    @property
+    def bounds(self) -> tuple[float, float]:
+        """(work, energy) per cycle (N·mm) that the physics forbids any cycle to exceed (inf: no bound): the loop
+        checks every cycle and the accumulated work against them, independently of the invariant."""
 
     def expected_volumes(self, cycles: int, work: float) -> tuple[float, float]:
         """(moving, stationary) wear volumes (mm³) the invariant demands after ``cycles`` with accumulated

@@ -65,12 +65,19 @@ class UniformCycle:
         nan = float("nan")
         return Cycle(
             pressure=p, pressure_stationary=p_av, rate_moving=r_m, rate_stationary=r_s,
-            slip_moving=np.where(p > 0, travel, 0.0), slip_stationary=np.where(p_av > 0, travel, 0.0),
+            slip_moving=np.where(p > 0, travel, 0.0), slip_stationary=travel * stroke_average((p > 0).astype(float), self.grid.dx, self.stroke),
             shear=mu * p if mu is not None else np.full(p.shape, nan),
             energy=mu * self.total_load * travel if mu is not None else nan,
             work=self.total_load * travel,
             force_amplitude=mu * self.total_load if mu is not None else nan,
             regime="gross_slip", stick_half_width_x=0.0, contact=res, iterations=res.iterations)
+
+    @property
+    def bounds(self) -> tuple[float, float]:
+        """(work, energy) per cycle that no cycle may exceed: here they are reached exactly (N·mm)."""
+        mu = self.friction_coefficient
+        return self.total_load * 4.0 * self.stroke, (mu * self.total_load * 4.0 * self.stroke if mu is not None
+                                                      else float("inf"))
 
     def expected_volumes(self, cycles: int, work: float) -> tuple[float, float]:
         # closed form, not the accumulated work: the paper's invariant exactly
