@@ -51,6 +51,9 @@ from fretsim.wear import gap_wear, sweep_deposit, sweep_read, wear_operator
 CORRECTIONS = 1  # fixed-point corrections of an implicit step's gap for the wear its cycle really found: the
 #                 linearised step alone is first-order in the step (its bias ∝ the step), one correction cuts the
 #                 depth error 4× at a third of the solves (ball_partial_slip against the per-cycle run: README)
+SPREAD_TO_CORRECT = 0.1  # ... where the slip varies by more than this share of its largest (1 − mean/max): in gross
+#                         slip far above δ_t every point slides nearly alike, the linearisation is nearly exact
+#                         (McColl 185 N: 1e-5 without the correction) and the correction would cost 1.5× the time
 TRAVEL_TOLERANCE = 0.1  # of an element: a resolved increment is solved again where a point's predicted travel was off
 #                         by more (the pressure follows the worn flat on that scale)
 
@@ -130,7 +133,8 @@ class CoulombCycle:
               cycle: int = 0, detail: bool = True) -> Cycle:
         """One cycle; an implicit step's (``step`` > 0) corrected CORRECTIONS times for its linearisation."""
         cyc = self._solve(wear_moving, wear_stationary, normal, guess, step, memory, cycle, detail)
-        for _ in range(CORRECTIONS if step and self.stroke_model != "resolved" else 0):
+        uneven = float((memory or {}).get("slip_spread", 1.0)) > SPREAD_TO_CORRECT
+        for _ in range(CORRECTIONS if step and uneven and self.stroke_model != "resolved" else 0):
             cyc = self._solve(wear_moving, wear_stationary, normal, cyc.pressure, step, memory, cycle, detail,
                               correction=cyc.mismatch)
         return cyc
@@ -223,7 +227,7 @@ class CoulombCycle:
             regime="partial_slip" if stick_end.any() else "gross_slip",
             stick_half_width_x=stick_half_width(stick_end[shape[0] // 2], g.x, dx), contact=res_mid,
             iterations=iterations, loop=(np.array(loop_u), np.array(loop_q)),
-            memory={"slip_lin": max(s_max, 1e-300)}, defect=defect, mismatch=mismatch,
+            memory={"slip_lin": max(s_max, 1e-300), "slip_spread": 1.0 - s_mean / s_max if s_max > 0 else 1.0}, defect=defect, mismatch=mismatch,
             stick=stick_end if stick_end.any() else None)
 
     def _tangential(self, q, p, du):
