@@ -179,6 +179,27 @@ def test_paper_preset_is_scaled_to_the_grids_limit_and_says_so():
     assert out.setup.linear_jump < 55 < out.setup.stability_limit * 2 and "exceeds this grid's" in choice.reason
 
 
+def test_the_papers_adaptive_jumps_beyond_the_stability_limit_are_capped_and_then_meet_the_per_cycle_run():
+    """McColl 1670 N in 2D with the paper's preset: ΔN_max 600 against an explicit limit of 159.  The jumps are
+    explicit, so each multiplies the grid-scale wear modes 6.6-fold; the linear steps between damp them, the run
+    stays bounded and its depth good (1e-4), but the pressure after a jump rings at the contact's edges
+    (272/98/207/140 MPa) and the final field was 8 % (L2) from the per-cycle run, with nothing said.  The plan
+    now caps ΔN_max at the limit and says why (measured 0.25 %); uncapped (a study of the instability, API only)
+    it still reproduces the 8 %."""
+    ov = ["model.dimension=2d", "jumping.scheme=adaptive", "jumping.preset=paper"]
+    exact = run(load_case(CASES / "mccoll_1670N.yaml", ["model.dimension=2d", "jumping.scheme=linear",
+                                                        "jumping.linear=1"]))
+    capped = run(load_case(CASES / "mccoll_1670N.yaml", ov))
+    choice = next(c for c in capped.plan.choices if c.key == "jumping.max")
+    assert capped.setup.max_jump <= capped.setup.stability_limit and "capped at the explicit stability" in choice.reason
+    setup, _, _ = prepare(load_case(CASES / "mccoll_1670N.yaml", ov), allow_unstable=True)
+    assert setup.max_jump == 600
+    last = simulate(setup)
+    l2 = lambda p: float(np.linalg.norm(p - exact.last.pressure) / np.linalg.norm(exact.last.pressure))  # noqa
+    assert l2(last.pressure) > 0.04  # measured 8.3 %: the ringing this test is about
+    assert l2(capped.last.pressure) < 0.01  # measured 0.25 %: a stepping error, within the default tolerance
+
+
 def test_solves_grow_logarithmically_with_cycles():
     counts = [run(load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", f"loading.cycles={n}",
                                                          f"output.snapshots=[{n}]"])).summary["contact_solves"]
