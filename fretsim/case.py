@@ -11,6 +11,8 @@ from __future__ import annotations
 import copy
 import difflib
 import functools
+import hashlib
+import json
 import math
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -253,6 +255,13 @@ class Case:
             mu = self.friction_coefficient
             return self.moving.energy_wear_coefficient * mu, self.stationary.energy_wear_coefficient * mu
         return self.moving.wear_coefficient, self.stationary.wear_coefficient
+
+    def fingerprint(self) -> str:
+        """sha256 of what the case asks for, as given (automatic choices unfilled; the `expected` data left out,
+        since they change no result): two cases with the same fingerprint run the same.  A sweep compares it with
+        the one a point's results file was written for, so a changed base case or `set:` runs the point again."""
+        asked = {k: v for k, v in self.to_dict().items() if k != "expected"}
+        return hashlib.sha256(json.dumps(asked, sort_keys=True, default=str).encode()).hexdigest()
 
     def with_choices(self, **kw: Any) -> "Case":
         return replace(self, **kw)

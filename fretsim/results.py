@@ -1,6 +1,7 @@
 """The HDF5 results file: layout, crash-safe exclusive writer, and a reader that verifies what it reads.
 
-    /                  attrs format_version, fretsim_version, status, status_message, case_name, notes
+    /                  attrs format_version, fretsim_version, status, status_message, case_name, notes,
+                       input_sha256 (the case as asked for, before the plan filled it: Case.fingerprint)
     /case              the validated case with defaults and automatic choices filled (YAML text; attr sha256)
     /inputs            the resolved inputs as scalar datasets with units; attrs overrides (the --set items), case_file
     /choices           every automatic choice: key, value, reason, given (one entry each)
@@ -241,12 +242,15 @@ class ResultsWriter:
     """
 
     def __init__(self, path: str | Path, case_yaml: str, case_name: str, grid, notes=(), overwrite: bool = False,
-                 previous: Optional["Results"] = None, choices=(), inputs: Optional[dict] = None):
+                 previous: Optional["Results"] = None, choices=(), inputs: Optional[dict] = None,
+                 input_sha256: str = ""):
         self.path = Path(path)
         self.replace = overwrite or previous is not None
         if self.path.exists() and not self.replace:
             raise FileExistsError(f"{self.path} exists")
         self.case_yaml, self.case_name, self.grid, self.notes = case_yaml, case_name, grid, tuple(notes)
+        # what the case asked for before the plan filled it (Case.fingerprint); a resumed run keeps its original
+        self.input_sha256 = str(previous.attrs.get("input_sha256", "")) if previous is not None else input_sha256
         self.choices = tuple(choices)
         self.inputs = inputs or {}
         if previous is not None:
@@ -344,7 +348,8 @@ class ResultsWriter:
         grid = self.grid
         text = h5py.string_dtype()
         f.attrs.update(format_version=FORMAT_VERSION, fretsim_version=__version__, status=self.status,
-                       status_message=self.message, case_name=self.case_name, notes="\n".join(self.notes))
+                       status_message=self.message, case_name=self.case_name, notes="\n".join(self.notes),
+                       input_sha256=self.input_sha256)
         c = f.create_dataset("case", data=self.case_yaml, dtype=text)
         c.attrs["sha256"] = hashlib.sha256(self.case_yaml.encode()).hexdigest()
         c.attrs["long_name"] = "the validated case with every default and automatic choice filled (YAML)"

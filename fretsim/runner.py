@@ -134,7 +134,8 @@ def run(case: Case, output: Optional[str | Path] = None, *, overwrite: bool = Fa
     try:
         if on_plan is not None:
             on_plan(setup, filled, plan)
-        return _execute(setup, filled, plan, output, overwrite, progress, observers, resume_from=None)
+        return _execute(setup, filled, plan, output, overwrite, progress, observers, resume_from=None,
+                        input_sha256=case.fingerprint())
     finally:
         if claim is not None:
             claim.release()
@@ -178,7 +179,8 @@ def resume(output: str | Path, *, progress: Optional[Callable[[int], None]] = No
             claim.release()
 
 
-def _execute(setup, filled, plan, output, overwrite, progress, observers, resume_from: Optional[Results]) -> Outcome:
+def _execute(setup, filled, plan, output, overwrite, progress, observers, resume_from: Optional[Results],
+             input_sha256: str = "") -> Outcome:
     counter = _Counter(len(resume_from.history["cycle"]) if resume_from is not None else 0,
                        _recorded_errors(resume_from) if resume_from is not None else (0.0, 0.0))
     writer = None
@@ -191,7 +193,8 @@ def _execute(setup, filled, plan, output, overwrite, progress, observers, resume
             nonlocal writer
             if writer is None and output is not None:
                 writer = ResultsWriter(output, filled.to_yaml(), filled.name, setup.grid, setup.notes, overwrite,
-                                       previous=resume_from, choices=plan.choices, inputs=inputs_of(filled))
+                                       previous=resume_from, choices=plan.choices, inputs=inputs_of(filled),
+                                       input_sha256=input_sha256)
             if writer is not None:
                 writer.on_step(setup_, step)
 
@@ -203,7 +206,8 @@ def _execute(setup, filled, plan, output, overwrite, progress, observers, resume
             counter.last = last
             if output is not None and writer is None:
                 writer = ResultsWriter(output, filled.to_yaml(), filled.name, setup.grid, setup.notes, True,
-                                       previous=resume_from, choices=plan.choices, inputs=inputs_of(filled))
+                                       previous=resume_from, choices=plan.choices, inputs=inputs_of(filled),
+                                       input_sha256=input_sha256)
                 writer.state = resume_from.checkpoint
     except ResolutionError as exc:  # found before anything is written: an input problem, named as such
         given = any(c.key == "grid.elements" and c.given for c in plan.choices)

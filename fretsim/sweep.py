@@ -17,7 +17,9 @@ per point: its swept values, status, message and summary.  table.h5 is readable 
 "h5netcdf"): a product sweep's outputs are arrays over its axes, with the axis values as coordinates (numbers
 in mm, N, MPa, 1/MPa, with units); other sweeps run over a ``point`` dimension.
 
-Re-running a sweep skips complete points and resumes interrupted ones (their results files say which); a point
+Re-running a sweep skips complete points and resumes interrupted ones (their results files say which) — only
+those whose file was written for the case the sweep would run now (``Case.fingerprint``); the others run again and
+their rows say why.  A point
 that fails or is refused is recorded with its status and message and does not stop the others.
 """
 from __future__ import annotations
@@ -47,6 +49,7 @@ class Point:
     name: str
     overrides: tuple  # ("key=value", ...) the point's own, after the shared ones
     values: dict  # key → value as written
+    fingerprint: str = ""  # Case.fingerprint of the case this point runs: its results file must have been made for it
 
 
 @dataclass
@@ -151,7 +154,7 @@ def load_sweep(path: str | Path) -> Sweep:
     for i, values in enumerate(points):
         overrides = tuple(f"{k}={_text(v)}" for k, v in values.items())
         try:
-            parse_case(base_text, source=base_source, overrides=[*shared, *overrides])
+            case = parse_case(base_text, source=base_source, overrides=[*shared, *overrides])
         except CaseError as exc:
             label = f"points[{i}]" if mode == "points" else f"point {', '.join(f'{k}={_text(v)}' for k, v in values.items())}"
             problems += [(f"{label}: {p}" if p else label, m) for p, m in exc.problems]
@@ -160,7 +163,7 @@ def load_sweep(path: str | Path) -> Sweep:
         if name in names:
             problems.append((f"points[{i}]", f"the same values as an earlier point ({name})"))
         names.add(name)
-        sweep.points.append(Point(name, overrides, dict(values)))
+        sweep.points.append(Point(name, overrides, dict(values), case.fingerprint()))
     if problems:
         raise CaseError(source, problems[:50] + ([("", f"… and {len(problems) - 50} more")] if len(problems) > 50
                                                  else []), "sweep file")
@@ -235,16 +238,22 @@ def run_point_remote(task: tuple) -> dict:
     return row
 
 
-def _state(path: Path) -> str:
-    """What a point's results file says: missing, complete, resumable, or done (failed/stopped), unreadable."""
+def _state(path: Path, fingerprint: str) -> str:
+    """What a point's results file says: missing, complete, resumable, done (failed/stopped), unreadable, or stale
+    (written for other inputs: the base case, the shared `set:` or the file were changed since)."""
     if not path.exists():
         return "missing"
     from fretsim.results import read_results
     try:
-        status = read_results(path).status
+        res = read_results(path)
     except ValueError:
         return "unreadable"
-    return {"complete": "complete", "running": "resumable", "interrupted": "resumable"}.get(status, "done")
+    if res.attrs.get("input_sha256") != fingerprint:
+        return "stale"
+    return {"complete": "complete", "running": "resumable", "interrupted": "resumable"}.get(res.status, "done")
+
+
+STALE = "ran again: its results file was written for other inputs (the base case, `set:` or the file changed)"
 
 
 @dataclass
@@ -279,14 +288,17 @@ def run_sweep(sweep: Sweep, outdir: str | Path, jobs: int = 0, dask: Optional[st
     spec_path.write_text(json.dumps(sweep.spec(), indent=1))
     statuses = {}
     tasks = []
+    stale = set()
     for p in sweep.points:
         out = outdir / "points" / f"{p.name}.h5"
-        state = "missing" if overwrite else _state(out)
+        state = "missing" if overwrite else _state(out, p.fingerprint)
         if state == "complete" or state == "done":
             statuses[p.name] = None  # read from its file for the table
             continue
         if state == "unreadable":
             out.unlink()
+        if state == "stale":
+            stale.add(p.name)
         mode = "resume" if state == "resumable" else "run"
         tasks.append((p.name, sweep.base_text, sweep.base_source, (*sweep.shared, *p.overrides), out, mode))
     try:
@@ -296,7 +308,7 @@ def run_sweep(sweep: Sweep, outdir: str | Path, jobs: int = 0, dask: Optional[st
             results = _run_local(tasks, jobs or os.cpu_count() or 1, progress)
         statuses.update({r["name"]: r for r in results})
     finally:
-        rows = _table_rows(sweep, outdir, statuses)
+        rows = _table_rows(sweep, outdir, statuses, stale)
         csv_path, h5_path = write_table(sweep, rows, outdir)
     counts = {s: sum(1 for r in rows if r["status"] == s) for s in {r["status"] for r in rows}}
     return SweepOutcome(rows, csv_path, h5_path, counts)
@@ -361,13 +373,20 @@ def _run_dask(tasks: list, address: str, progress) -> list:
     return results
 
 
-def _table_rows(sweep: Sweep, outdir: Path, statuses: dict) -> list:
+def _table_rows(sweep: Sweep, outdir: Path, statuses: dict, stale: frozenset = frozenset()) -> list:
     from fretsim.results import read_results
     rows = []
     for p in sweep.points:
         out = outdir / "points" / f"{p.name}.h5"
         row = {"point": p.name, **{k: _text(v) for k, v in p.values.items()}}
         known = statuses.get(p.name)
+        if p.name in stale and not (known and (known.get("summary") or known.get("status") == "refused")):
+            # its file is another case's: never show its numbers
+            row.update(status=(known or {}).get("status", "not run"),
+                       message="its results file was written for other inputs and it has not run again yet; "
+                               "re-run the sweep")
+            rows.append(row)
+            continue
         if known and (known.get("summary") or known.get("status") == "refused"):  # this run's: no need to read
             row.update(status=known["status"], message=known.get("message", ""))
             row.update(known.get("summary") or {})
@@ -378,6 +397,8 @@ def _table_rows(sweep: Sweep, outdir: Path, statuses: dict) -> list:
                 row.update(res.summary)
             except ValueError:
                 row.update(status=(known or {}).get("status", "not run"), message=(known or {}).get("message", ""))
+        if p.name in stale:
+            row["message"] = STALE + (f"; {row['message']}" if row.get("message") else "")
         rows.append(row)
     return rows
 

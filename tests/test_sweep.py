@@ -119,6 +119,47 @@ def test_re_running_a_sweep_skips_complete_points(local_sweep):
     assert time.perf_counter() - t < 5
 
 
+def _small_base(tmp_path, k_moving="2e-8 1/MPa"):
+    base = tmp_path / "base.yaml"
+    base.write_text((CASES / "mccoll_185N.yaml").read_text().replace("wear_coefficient: 2.0e-8 1/MPa",
+                                                                       f"wear_coefficient: {k_moving}"))
+    assert k_moving == "2e-8 1/MPa" or k_moving in base.read_text()
+    return base
+
+
+def test_a_sweep_runs_again_the_points_whose_base_case_changed_and_says_so(tmp_path):
+    """A point's results file is trusted only when it was written for the case the sweep would run now: after
+    the base case's wear coefficient is multiplied by 10, every point runs again (the table equals a fresh sweep's
+    of the new base, not the old depths read back) and says why."""
+    base = _small_base(tmp_path)
+    text = SMALL.replace(str(CASES / "mccoll_185N.yaml"), str(base))
+    path = sweep_file(tmp_path, text)
+    first = run_sweep(load_sweep(path), tmp_path / "o", jobs=2)
+    _small_base(tmp_path, "2e-7 1/MPa")
+    second = run_sweep(load_sweep(path), tmp_path / "o", jobs=2)
+    fresh = run_sweep(load_sweep(path), tmp_path / "fresh", jobs=2)
+    assert second.all_complete
+    for a, b, c in zip(first.rows, second.rows, fresh.rows):
+        assert b["max_wear_depth_moving_um"] == c["max_wear_depth_moving_um"] > 5 * a["max_wear_depth_moving_um"]
+        assert "other inputs" in b["message"]
+    third = run_sweep(load_sweep(path), tmp_path / "o", jobs=2)  # nothing changed now: trusted, not re-run
+    assert [r["max_wear_depth_moving_um"] for r in third.rows] == [r["max_wear_depth_moving_um"] for r in second.rows]
+    assert not any("other inputs" in r["message"] for r in third.rows)
+
+
+def test_a_sweep_runs_again_when_its_shared_settings_change_or_a_file_is_copied_over_another(tmp_path):
+    path = sweep_file(tmp_path)
+    first = run_sweep(load_sweep(path), tmp_path / "o", jobs=2)
+    points = sorted((tmp_path / "o" / "points").iterdir())
+    points[1].write_bytes(points[0].read_bytes())  # another point's complete file under this point's name
+    again = run_sweep(load_sweep(path), tmp_path / "o", jobs=2)
+    assert [r["max_wear_depth_moving_um"] for r in again.rows] == [r["max_wear_depth_moving_um"] for r in first.rows]
+    assert sum("other inputs" in r["message"] for r in again.rows) == 1
+    sweep_file(tmp_path, SMALL.replace("loading.cycles=400", "loading.cycles=800").replace("[400]", "[800]"))
+    longer = run_sweep(load_sweep(path), tmp_path / "o", jobs=2)
+    assert all(r["cycles"] == 800 and "other inputs" in r["message"] for r in longer.rows)
+
+
 def test_a_failing_point_is_recorded_and_the_others_complete(tmp_path):
     text = SMALL.replace("axes:\n  loading.normal_load: [150 N, 185 N]\n  loading.stroke: [10 um, 25 um]\n",
                          "mode: product\naxes:\n  jumping.linear: [5, 10000]\n") + "  jumping.scheme: [linear]\n"
