@@ -95,7 +95,8 @@ GEOMETRY_KEYS: dict[str, dict[str, Key]] = {
                                       "roller (at least L); omitted: the flat runs on well beyond the contact", None,
                             plausible=LENGTH_RANGE),
         "profile": Key("profile_file", "a CSV of the axial profile drop: a header `y [unit], drop [unit]`, then rows "
-                               "(relative to the case file; mirrored if given for y ≥ 0 only)", None),
+                               "(relative to the case file; read as given, so an asymmetric profile stays asymmetric; mirrored if "
+                               "given for y ≥ 0 only; it must cover the roller's length; 3D only)", None),
         "profile_table": Key("table", "the same profile inline: {y: [lengths], drop: [lengths]} (the filled case "
                                       "carries it, so a results file reruns without the CSV)", None)},
 }
@@ -571,6 +572,7 @@ def _read_profile(name, source: str, r: "_Reader", key: str = "geometry.profile"
     except (OSError, ValueError) as exc:
         r.fail(key, f"{path}: {exc}")
         return None
+    text = text.removeprefix("\ufeff")  # a byte-order mark, as spreadsheets write it
     rows = [row for row in csv.reader(text.splitlines()) if row and not row[0].lstrip().startswith("#")]
     head = [h.strip() for h in rows[0]] if rows else []
     units = [re.fullmatch(r"\w+\s*\[(.+)\]", h) for h in head[:2]]
@@ -579,6 +581,10 @@ def _read_profile(name, source: str, r: "_Reader", key: str = "geometry.profile"
                                    f"'y [mm], drop [um]'")
         return None
     scale = [UNITS["length"][u.group(1)] for u in units]
+    short = next((i for i, row in enumerate(rows[1:], 2) if len(row) < 2), None)
+    if short is not None:
+        r.fail(key, f"{path}: data row {short} has one column; expected two numbers, y and drop")
+        return None
     try:
         data = np.array([[float(v) for v in row[:2]] for row in rows[1:]])
     except ValueError as exc:

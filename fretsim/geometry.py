@@ -85,6 +85,7 @@ class Geometry:
         return self.line_length is not None
 
     body_corrections: ClassVar[tuple[str, ...]] = ()  # compliance corrections of the body's own shape
+    axial_profile: ClassVar[bool] = False  # a shape along the line (y) that a 2D section cannot carry
 
     def extra_compliance(self, grid: Grid, youngs_modulus: float, poissons_ratio: float):
         return None
@@ -281,10 +282,12 @@ class TubeOnFlat(Geometry):
 class RollerOnFlat(CylinderOnFlat):
     """A roller of radius R and length L whose axial profile drops by d(y) from the middle: crowned (a crown
     radius: d = y²/2R_c), edge-rounded (flat over a middle length, then circular: d = (|y| − l/2)²/2r_e), or
-    tabulated (d at points along y, interpolated linearly, mirrored if given for y ≥ 0 only) — what designers
+    tabulated (d at points along y, interpolated linearly, read as given — an asymmetric profile is asymmetric —
+    and mirrored if given for y ≥ 0 only; it must cover the whole length) — what designers
     optimise against the finite cylinder's end peaks.  Gap: x²/2R + d(y) (Eq. 9 plus the profile)."""
 
     kind: ClassVar[str] = "roller_on_flat"
+    axial_profile: ClassVar[bool] = True
     radius: float
     length: float
     crown_radius: Optional[float] = None
@@ -305,24 +308,43 @@ class RollerOnFlat(CylinderOnFlat):
             fail("flat_length", "an edge-rounded roller needs the length of its straight middle")
             return None
         cylinder = CylinderOnFlat.from_case({k: values[k] for k in ("radius", "length", "block_length")}, fail)
-        return None if cylinder is None else cls(**values, profile_y=table[0], profile_drop=table[1])
+        if cylinder is None:
+            return None
+        roller = cls(**values, profile_y=table[0], profile_drop=table[1])
+        if table[0] is not None:
+            py, _ = roller.table()
+            half = 0.5 * values["length"]
+            slack = 1e-9 * half  # a table written to the end in rounded millimetres covers it
+            if py[0] > -half + slack or py[-1] < half - slack:
+                fail("profile", f"the profile covers y from {py[0]:.4g} to {py[-1]:.4g} mm (mirrored where given for "
+                                f"y ≥ 0 only), but the roller reaches ±{half:.4g} mm: give the drop over the whole "
+                                f"length, so that none of it is guessed")
+                return None
+        return roller
 
     # a cylinder's Hertz estimate, limits and scar estimate: the profile only relieves its ends
 
     def drop(self, y: np.ndarray) -> np.ndarray:
-        y = np.abs(np.asarray(y, dtype=float))
+        y = np.asarray(y, dtype=float)
+        a = np.abs(y)  # the crown and the edge rounding are symmetric by definition; a table is read as given
         d = np.zeros_like(y)
         if self.crown_radius:
-            d = d + y**2 / (2 * self.crown_radius)
+            d = d + a**2 / (2 * self.crown_radius)
         if self.edge_radius:
             flat = 0.5 * (self.flat_length if self.flat_length is not None else 0.0)
-            d = d + np.clip(y - flat, 0.0, None) ** 2 / (2 * self.edge_radius)
+            d = d + np.clip(a - flat, 0.0, None) ** 2 / (2 * self.edge_radius)
         if self.profile_y is not None:
-            py, pd = np.asarray(self.profile_y), np.asarray(self.profile_drop)
-            if py.min() >= 0:
-                py, pd = np.concatenate([-py[::-1], py]), np.concatenate([pd[::-1], pd])
+            py, pd = self.table()
             d = d + np.interp(y, py, pd)
         return d
+
+    def table(self) -> tuple[np.ndarray, np.ndarray]:
+        """The tabulated profile over the whole roller: as given, or mirrored when given for y ≥ 0 only."""
+        py, pd = np.asarray(self.profile_y, dtype=float), np.asarray(self.profile_drop, dtype=float)
+        if py.min() >= 0:
+            keep = py > 0  # y = 0 once
+            py, pd = np.concatenate([-py[keep][::-1], py]), np.concatenate([pd[keep][::-1], pd])
+        return py, pd
 
     def separation(self, grid: Grid) -> np.ndarray:
         return _line_gap(grid, self.radius, self.length, None if grid.plane_strain else self.drop(grid.y))

@@ -387,6 +387,10 @@ def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0) -> t
         raise CaseError(case.source, problems)
     dimension = plan.add(choose_dimension(case, e_star))
     plane = dimension == "2d"
+    if plane and g.axial_profile:
+        plan.warnings.append(f"the {g.kind}'s axial profile (its drop along y) is not modelled in 2D: a 2D run is "
+                             f"the plane-strain section of a straight cylinder, the same whatever the profile; use "
+                             f"model.dimension: 3d for the profile's effect")
     sizing = auto_grid(g, plane, case.normal_load, case.stroke, case.cycles, k_m + k_s, e_star, refine=_refine)
     gap_probe = choose_gap_model(case, Grid.centred(3, 1, sizing.domain[0] / sizing.elements[0], 1.0, True))
     if gap_probe.value == "stroke_average":  # its wear reaches two strokes beyond the contact

@@ -148,6 +148,46 @@ def test_a_profile_without_units_in_its_header_is_refused(tmp_path):
     assert r.exit_code == 2 and "geometry.profile" in r.output and "units" in r.output
 
 
+def _roller_with_profile(tmp_path, csv_text: str, raw: bool = False):
+    (tmp_path / "profile.csv").write_bytes(csv_text.encode("utf-8-sig" if raw else "utf-8"))
+    text = (CASES / "roller_edge_rounded.yaml").read_text().replace(
+        "edge_radius: 20 mm, flat_length: 9 mm", "profile: profile.csv")
+    (tmp_path / "r.yaml").write_text(text)
+    return tmp_path / "r.yaml"
+
+
+def test_an_asymmetric_profile_is_read_whole_and_relieves_only_its_own_end(tmp_path):
+    """A table that drops 5 µm over the last half millimetre at y = −5 mm and nothing at +5 mm relieves the −y end
+    only: the unworn contact lifts off that end row and carries less of the load on that half (the table's y < 0
+    half was read as |y| before: both ends alike, a roller with no relief at all)."""
+    case = load_case(_roller_with_profile(tmp_path, "y [mm], drop [um]\n-5, 5\n-4.5, 0\n5, 0\n"),
+                     ["loading.cycles=0", "model.dimension=3d"])
+    assert case.geometry.drop(np.array([-5.0, -4.5, 0.0, 5.0])) == pytest.approx([0.005, 0.0, 0.0, 0.0])
+    p = run(case).last.pressure
+    load_per_row = p.sum(axis=1)
+    ny = p.shape[0]
+    assert load_per_row[: ny // 2].sum() < 0.97 * load_per_row[ny - ny // 2:].sum()  # measured 0.95
+    assert p[0].max() < 0.5 * p[-1].max()  # the relieved end row (measured 0) against the other end's
+
+
+def test_a_profile_that_does_not_cover_the_roller_is_refused(tmp_path):
+    path = _roller_with_profile(tmp_path, "y [mm], drop [um]\n0, 0\n3, 2\n")
+    r = CliRunner().invoke(main, ["check", str(path)])
+    assert r.exit_code == 2 and "geometry.profile" in r.output and "whole length" in r.output, r.output
+
+
+def test_a_profile_with_one_column_is_refused_and_one_with_a_byte_order_mark_is_read(tmp_path):
+    r = CliRunner().invoke(main, ["check", str(_roller_with_profile(tmp_path, "y [mm], drop [um]\n0\n5\n"))])
+    assert r.exit_code == 2 and "one column" in r.output and "Traceback" not in r.output, r.output
+    case = load_case(_roller_with_profile(tmp_path, "y [mm], drop [um]\n0, 0\n4.5, 0\n5, 2\n", raw=True))
+    assert case.geometry.drop(np.array([5.0]))[0] == pytest.approx(0.002)
+
+
+def test_a_profiled_roller_in_2d_says_its_profile_is_not_modelled():
+    _, _, plan = prepare(load_case(CASES / "roller_edge_rounded.yaml", ["model.dimension=2d"]))
+    assert any("axial profile" in w and "not modelled in 2D" in w for w in plan.warnings)
+
+
 # --- what auto chooses, and check on every shipped case --------------------------------------------------------------
 
 @pytest.mark.parametrize("name, dimension", [("mccoll_185N", "3d"), ("roller_edge_rounded", "3d"),
