@@ -14,6 +14,9 @@
                        (cycle, point); no points for the uniform-slip model, which has no loop
     /checkpoint        the loop's state at the last written step, for `fretsim run --resume` (attr sha256)
 
+Format 1.3 seals the rest too: every dataset carries ``sha256`` of its values, every group (and the root)
+``attrs_sha256`` of its attributes and member names; readers refuse a file that differs, naming where.
+
 The layout is a contract (README): names are only ever added.  Every dataset has ``units`` and ``long_name``,
 and the dimension scales make ``xarray.open_dataset(path, engine="h5netcdf", group="fields")`` come out
 labelled.  Format 1.2 adds /inputs, /choices, the dimension scales, the summary datasets and the checksums to
@@ -426,6 +429,7 @@ class ResultsWriter:
                 elif value is not None:
                     c.attrs[key] = value
             c.attrs["sha256"] = _checkpoint_digest(self.state)
+        _seal(f)
 
     def _write_inputs(self, f: h5py.File) -> None:
         g = f.create_group("inputs")
@@ -435,6 +439,77 @@ class ResultsWriter:
             ds.attrs.update(units=units, long_name=long_name)
         g.attrs["overrides"] = json.dumps(list(self.inputs.get("overrides", [])))
         g.attrs["case_file"] = str(self.inputs.get("case_file", ""))
+
+
+# --- checksums: every dataset and every group's attributes carry a sha256 of what was written ----------------------
+SEALED_FROM = "1.3"  # files of this format on carry (and must carry) the checksums
+_SCALE_ATTRS = {"DIMENSION_LIST", "REFERENCE_LIST", "CLASS", "NAME", "sha256", "attrs_sha256"}  # HDF5's own, ours
+
+
+def _value_digest(value) -> str:
+    """sha256 of a dataset's value as read back: a text by its UTF-8 bytes (so /case's is the sha256 of its YAML,
+    as it always was), an array by its type, shape and bytes."""
+    if isinstance(value, bytes):
+        return hashlib.sha256(value).hexdigest()
+    if isinstance(value, str):
+        return hashlib.sha256(value.encode()).hexdigest()
+    a = np.asarray(value)
+    h = hashlib.sha256(f"{a.dtype.str}{a.shape}".encode())
+    if a.dtype.kind == "O":
+        for v in a.ravel():
+            h.update(v if isinstance(v, bytes) else str(v).encode())
+            h.update(b"\0")
+    else:
+        h.update(np.ascontiguousarray(a).tobytes())
+    return h.hexdigest()
+
+
+def _attrs_digest(obj) -> str:
+    """sha256 of an object's attributes and, for a group, of the names it holds (so a deleted or added dataset
+    shows)."""
+    h = hashlib.sha256()
+    if isinstance(obj, h5py.Group):
+        h.update(("members:" + "\0".join(sorted(obj.keys())) + "\0").encode())
+    for k in sorted(k for k in obj.attrs.keys() if k not in _SCALE_ATTRS):
+        v = obj.attrs[k]
+        h.update(k.encode() + b"=")
+        h.update(v if isinstance(v, bytes) else _value_digest(v).encode() if isinstance(v, np.ndarray) else
+                 repr(v).encode())
+        h.update(b"\0")
+    return h.hexdigest()
+
+
+def _sealed_objects(f):
+    """Every group (the root included) and dataset the readers trust; /checkpoint carries its own digest."""
+    out = [("", f)]
+    f.visititems(lambda name, obj: None if name == "checkpoint" or name.startswith("checkpoint/") else
+                 out.append((name, obj)))
+    return out
+
+
+def _seal(f) -> None:
+    for name, obj in _sealed_objects(f):
+        if isinstance(obj, h5py.Dataset):
+            obj.attrs["sha256"] = _value_digest(obj[()])
+        obj.attrs["attrs_sha256"] = _attrs_digest(obj)
+
+
+def _verify_seal(f) -> None:
+    """Refuse a file whose datasets or attributes differ from what was written, naming the first that does."""
+    for name, obj in _sealed_objects(f):
+        where = f"/{name}"
+        if isinstance(obj, h5py.Dataset):
+            if "sha256" not in obj.attrs:
+                raise _Damaged(f"{where}: its checksum is missing (every dataset of this format carries one)")
+            if obj.size * max(obj.dtype.itemsize, 1) > MAX_DATASET_BYTES:
+                raise _Damaged(f"{where}: declares {obj.size:.3g} values, more than any results file holds")
+            if _value_digest(obj[()]) != _text(obj.attrs["sha256"]):
+                raise _Damaged(f"{where}: its values do not match their checksum (changed since it was written)")
+        if "attrs_sha256" not in obj.attrs:
+            raise _Damaged(f"{where or '/'}: the checksum of its attributes is missing")
+        if _attrs_digest(obj) != _text(obj.attrs["attrs_sha256"]):
+            raise _Damaged(f"{where or '/'}: its attributes{'' if isinstance(obj, h5py.Dataset) else ' or the names it holds'}"
+                           f" do not match their checksum (changed since it was written)")
 
 
 def _fsync_dir(directory: Path) -> None:
@@ -582,7 +657,9 @@ def _read(f, path: str, for_resume: bool) -> Results:
     version = _text(f.attrs["format_version"])
     if version not in READABLE_FORMATS:
         raise _Damaged(f"format_version {version!r} is not one this fretsim reads ({', '.join(READABLE_FORMATS)})")
-    attrs = {k: _plain(v) for k, v in f.attrs.items()}
+    if version >= SEALED_FROM:
+        _verify_seal(f)
+    attrs = {k: _plain(v) for k, v in f.attrs.items() if k not in _SCALE_ATTRS}
     if attrs.get("status") not in STATUSES:
         raise _Damaged(f"the status {str(attrs.get('status'))[:40]!r} is not one of {', '.join(STATUSES)}")
     case_ds = f.get("case")
@@ -626,7 +703,7 @@ def _read(f, path: str, for_resume: bool) -> Results:
     summary = {}
     for k, v in _group(f, "summary").attrs.items():
         k = _name(k, "/summary")
-        if k == "units":
+        if k == "units" or k in _SCALE_ATTRS:
             continue
         v = _plain(v)
         if isinstance(v, (list, tuple, np.ndarray)) or not isinstance(v, (int, float, str, type(None))):

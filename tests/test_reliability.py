@@ -16,7 +16,7 @@ from hypothesis import HealthCheck, given, settings, strategies as st
 
 from fretsim.api import load_case, resume, run
 from fretsim.cli import main
-from fretsim.results import read_results
+from fretsim.results import _seal, read_results
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
 CASE = str(CASES / "mccoll_185N.yaml")
@@ -149,6 +149,7 @@ def test_a_run_killed_as_it_finished_resumes_to_complete_at_once(tmp_path):
     run(load_case(CASE, ["model.dimension=2d", "loading.cycles=500"]), out)
     with h5py.File(out, "r+") as f:  # what a kill between the last flush and the final status leaves
         f.attrs["status"] = "running"
+        _seal(f)  # as the writer seals every flush: a killed run's file is a consistent one
     before = read_results(out)
     assert resume(out).status == "complete"
     after = read_results(out)
@@ -158,6 +159,7 @@ def test_a_run_killed_as_it_finished_resumes_to_complete_at_once(tmp_path):
         run(load_case(CASE, ["model.dimension=2d", f"loading.cycles={cycles}"]), out0)
         with h5py.File(out0, "r+") as f:
             f.attrs["status"] = "interrupted"
+            _seal(f)
         assert resume(out0).status == "complete"
 
 
@@ -255,7 +257,80 @@ def good_file(tmp_path_factory):
     run(load_case(CASE, ["model.dimension=2d", "loading.cycles=600"]), path)
     with h5py.File(path, "r+") as f:
         f.attrs["status"] = "interrupted"  # resumable, so --resume has a checkpoint to verify
+        _seal(f)  # as an interrupted run's writer leaves it
     return path
+
+
+@pytest.fixture(scope="module")
+def genuine_resume(good_file, tmp_path_factory):
+    path = tmp_path_factory.mktemp("genuine") / "g.h5"
+    path.write_bytes(good_file.read_bytes())
+    assert resume(path).status == "complete"
+    return read_results(path)
+
+
+def _damage(kind: str, f: h5py.File) -> str:
+    """The damage the hostile pass found unnoticed; returns the dataset the refusal must name."""
+    if kind == "field-value":
+        f["fields/wear_depth_stationary"][-1, 0, 20] = -3.9e25
+        return "/fields/wear_depth_stationary"
+    if kind == "history-rows-deleted":
+        for k in list(f["history"].keys()):
+            data = f[f"history/{k}"][()]
+            attrs = dict(f[f"history/{k}"].attrs)
+            del f[f"history/{k}"]
+            ds = f.create_dataset(f"history/{k}", data=np.delete(data, [2, 3]))
+            ds.attrs.update({a: v for a, v in attrs.items() if a not in ("DIMENSION_LIST", "REFERENCE_LIST")})
+        return "/history/"
+    if kind == "case-rewritten":
+        text = f["case"][()].decode().replace("cycles: 600", "cycles: 900")
+        del f["case"]
+        f.create_dataset("case", data=text, dtype=h5py.string_dtype())
+        return "/case"
+    if kind == "summary-edited":
+        f["summary"].attrs["max_wear_depth_stationary_um"] = 99.0
+        return "/summary"
+    raise AssertionError(kind)
+
+
+@pytest.mark.parametrize("kind", ["field-value", "history-rows-deleted", "case-rewritten", "summary-edited"])
+def test_damage_outside_case_and_checkpoint_is_refused_by_every_command_naming_the_dataset(tmp_path, good_file,
+                                                                                           kind):
+    """Each of these used to pass: a field of −3.9e28 µm resumed to `complete` and showed in summary and export,
+    deleted history rows resumed with a gap, a /case rewritten without its checksum ran with an edited `cycles`.
+    Every dataset and every group's attributes now carry a sha256: summary, plot, export and --resume refuse the
+    file with exit 2 and name where it differs."""
+    path = tmp_path / "bad.h5"
+    path.write_bytes(good_file.read_bytes())
+    with h5py.File(path, "r+") as f:
+        where = _damage(kind, f)
+    before = path.read_bytes()
+    for args in (["summary", str(path), "--json"], ["plot", str(path), "-o", str(tmp_path / "plots")],
+                 ["export", str(path), "--csv", str(tmp_path / "csv")], ["run", "--resume", str(path)]):
+        r = CliRunner().invoke(main, args)
+        assert r.exit_code == 2 and where in r.output and "Traceback" not in r.output, (args, r.output)
+    assert path.read_bytes() == before  # refused, not touched
+
+
+@pytest.mark.parametrize("seed", range(24))
+def test_a_flipped_bit_never_resumes_to_other_numbers(tmp_path, good_file, genuine_resume, seed):
+    """5 of 24 random bit flips used to resume to `complete`.  A flip that lands in the data is now refused; one
+    that lands where HDF5 keeps nothing read (padding, free space) changes nothing: a resume that completes gives
+    the genuine run's arrays bit for bit."""
+    rng = np.random.default_rng(seed)
+    data = bytearray(good_file.read_bytes())
+    data[int(rng.integers(0, len(data)))] ^= 1 << int(rng.integers(0, 8))
+    path = tmp_path / "flip.h5"
+    path.write_bytes(bytes(data))
+    r = CliRunner().invoke(main, ["run", "--resume", str(path)])
+    assert r.exit_code in (0, 2) and "Traceback" not in r.output, r.output
+    if r.exit_code == 0:
+        res = read_results(path)
+        for k in genuine_resume.fields:
+            assert np.array_equal(res.fields[k], genuine_resume.fields[k], equal_nan=True), k
+        for k in genuine_resume.history:
+            if k != "wall_time":
+                assert np.array_equal(res.history[k], genuine_resume.history[k], equal_nan=True), k
 
 
 def _structural(kind: str, f: h5py.File) -> None:

@@ -158,15 +158,21 @@ def test_a_disk_that_fills_while_plotting_leaves_earlier_figures_whole_and_no_te
     assert {p.name: p.read_bytes() for p in tmp_path.iterdir()} == before
 
 
-def test_a_file_with_damaged_inputs_still_plots_its_data_and_says_what_it_could_not_read(results_3d, tmp_path):
-    # found by the slow fuzz (a flipped bit in an /inputs name): plot must not fail on metadata it only titles with
+def test_a_file_with_damaged_inputs_is_refused_and_one_written_without_them_plots_and_says_so(results_3d, tmp_path):
+    # found by the slow fuzz (a flipped bit in an /inputs name).  Damage is refused by the checksums, naming where;
+    # a file that was written without some inputs (consistent, sealed) still plots, titling what it lacks with '?'
     from fretsim.plotting import title_block
+    from fretsim.results import _seal
     path = tmp_path / "d.h5"
     path.write_bytes(Path(results_3d).read_bytes())
     with h5py.File(path, "r+") as f:
         del f["inputs/stroke"]
         del f["inputs/normal_load"]
         f["inputs/hertz_peak_pressure"][()] = np.nan
+    r = CliRunner().invoke(main, ["plot", str(path), "-o", str(tmp_path / "figs"), "--jobs", "1"])
+    assert r.exit_code == 2 and "/inputs" in r.output and "checksum" in r.output, r.output
+    with h5py.File(path, "r+") as f:
+        _seal(f)
     r = CliRunner().invoke(main, ["plot", str(path), "-o", str(tmp_path / "figs"), "--jobs", "1"])
     assert r.exit_code == 0, r.output
     assert len(list((tmp_path / "figs").glob("*.png"))) >= 4
