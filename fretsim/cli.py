@@ -70,7 +70,7 @@ def main() -> None:
 
 @main.command()
 @click.argument("case_file", required=False, type=click.Path(path_type=Path))
-@click.option("-o", "--output", type=click.Path(path_type=Path),
+@click.option("-o", "--output", type=click.Path(),  # text, not a Path: a trailing '/' (a directory) must survive
               help="Results file (default: CASE_FILE's name with .h5, in the current directory).")
 @click.option("--set", "overrides", multiple=True, metavar="KEY.PATH=VALUE",
               help="Override a case value, e.g. --set loading.cycles=1000 (repeatable).")
@@ -80,7 +80,7 @@ def main() -> None:
 @click.option("--quiet", is_flag=True, help="No notes, no progress bar; the summary paragraph only.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
 @_boundary
-def run(case_file: Path | None, output: Path | None, overrides: tuple, overwrite: bool, resume_file: Path | None,
+def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite: bool, resume_file: Path | None,
         quiet: bool, debug: bool) -> None:
     """Run CASE_FILE and write an HDF5 results file (or --resume one)."""
     import signal
@@ -448,6 +448,11 @@ def sweep(sweep_file: Path, outdir: Path, jobs: int, dask_address: str | None, o
             failures["n"] += 1
         if bar is not None:
             bar.update(1)
+
+    def _terminate(signum, frame):  # SIGTERM ends a sweep as Ctrl-C does: points interrupted, the table written
+        raise KeyboardInterrupt
+    import signal
+    signal.signal(signal.SIGTERM, _terminate)
     try:
         out = run_sweep(spec, outdir, jobs, dask_address, overwrite, _progress)
     except KeyboardInterrupt:

@@ -196,7 +196,13 @@ def check_output_path(path: str | Path, protect: tuple = ()) -> Path:
     if text in ("", "-"):
         raise ValueError(f"{text!r} is not a file name; results go to an HDF5 file, e.g. -o out.h5")
     if text.endswith(os.sep) or p.is_dir():
-        raise ValueError(f"{text} is a directory; give a file name, e.g. -o {os.path.join(text, 'out.h5')}")
+        what = "is a directory" if p.is_dir() else "ends in a '/', so it names a directory"
+        raise ValueError(f"{text} {what}; give a file name, e.g. -o {os.path.join(text, 'out.h5')}")
+    if p.is_symlink():
+        # the writer replaces the file by renaming over it, which would replace the link, not write through it
+        target = os.readlink(p)
+        raise ValueError(f"{text} is a symbolic link (to {target}{'' if p.exists() else ', which does not exist'}); "
+                         f"give the file's own name, or a new name")
     if len(p.name.encode()) > MAX_NAME:
         raise ValueError(f"the output name is {len(p.name.encode())} bytes long; at most {MAX_NAME}")
     parent = p.parent if str(p.parent) else Path(".")

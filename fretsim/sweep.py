@@ -175,6 +175,7 @@ def load_sweep(path: str | Path) -> Sweep:
 _IN_POINT = False  # a worker is inside a point's run (its SIGTERM then ends the run cleanly)
 
 
+_PARENT = 0  # the sweep process a worker serves (0: not in a worker)
 _STOPPING = False  # a worker was told to stop: it starts no further point (some may be queued already)
 
 
@@ -195,11 +196,37 @@ class _StopWhenTold:
             raise KeyboardInterrupt
 
 
-def _init_worker() -> None:
+def _init_worker(parent: int = 0) -> None:
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
         os.environ[var] = "1"
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent stops the sweep; workers are ended by SIGTERM
     signal.signal(signal.SIGTERM, _on_terminate)
+    global _PARENT
+    _PARENT = parent or os.getppid()
+    _die_with(_PARENT)
+
+
+def _die_with(parent: int) -> None:
+    """A worker whose sweep process dies (SIGKILL included) gets SIGTERM, as if told to stop: a running point
+    writes itself as interrupted, an idle worker leaves.  Linux says so at once (PR_SET_PDEATHSIG); elsewhere a
+    thread notices within a second that the worker was handed to another parent."""
+    try:
+        import ctypes
+        libc = ctypes.CDLL(None, use_errno=True)
+        if libc.prctl(1, int(signal.SIGTERM), 0, 0, 0) == 0:  # PR_SET_PDEATHSIG
+            if os.getppid() != parent:  # it died before the request took effect
+                os.kill(os.getpid(), signal.SIGTERM)
+            return
+    except (OSError, AttributeError):
+        pass
+    import threading
+    import time
+
+    def watch():
+        while os.getppid() == parent:
+            time.sleep(1.0)
+        os.kill(os.getpid(), signal.SIGTERM)
+    threading.Thread(target=watch, daemon=True).start()
 
 
 def run_point(task: tuple) -> dict:
@@ -225,6 +252,8 @@ def run_point(task: tuple) -> dict:
         return {"name": name, "status": "failed", "message": f"{type(exc).__name__}: {exc}"}
     finally:
         _IN_POINT = False
+        if _STOPPING and _PARENT and os.getppid() != _PARENT:
+            os._exit(0)  # the sweep is gone: its point is written (interrupted); nobody will send another
 
 
 def run_point_remote(task: tuple) -> dict:
@@ -325,7 +354,8 @@ def _run_local(tasks: list, jobs: int, progress) -> list:
     ctx = mp.get_context("fork" if "fork" in mp.get_all_start_methods() else "spawn")
     if ctx.get_start_method() == "fork":
         import fretsim.runner  # noqa: F401 - imported once here (scipy's FFT and interpolation, ~1.5 s), not per worker
-    pool = ProcessPoolExecutor(max_workers=max(1, min(jobs, len(tasks))), mp_context=ctx, initializer=_init_worker)
+    pool = ProcessPoolExecutor(max_workers=max(1, min(jobs, len(tasks))), mp_context=ctx, initializer=_init_worker,
+                               initargs=(os.getpid(),))
     try:
         futures = [pool.submit(run_point, t) for t in tasks]
         for f in as_completed(futures):

@@ -458,3 +458,24 @@ def test_an_interrupted_run_through_the_api_leaves_the_processs_signal_handling_
         run(load_case(CASE, ["model.dimension=2d", "loading.cycles=500"]), tmp_path / "s.h5", observers=(Stop(),))
     assert (signal.getsignal(signal.SIGINT), signal.getsignal(signal.SIGTERM)) == before
     assert read_results(tmp_path / "s.h5").status == "interrupted"
+
+
+@pytest.mark.parametrize("kind", ["dangling-link", "link", "trailing-slash"])
+def test_an_output_that_cannot_be_the_results_file_is_refused_before_the_run(tmp_path, kind):
+    """-o naming a dangling symbolic link used to compute the whole run, then exit 5 with "every step up to cycle
+    None"; -o newdir/ wrote a file named newdir.  Both are refused at once (exit 2), nothing written."""
+    target = tmp_path / "real.h5"
+    out = tmp_path / "out.h5"
+    if kind == "dangling-link":
+        out.symlink_to(tmp_path / "missing" / "x.h5")
+    elif kind == "link":
+        target.write_bytes(b"keep")
+        out.symlink_to(target)
+    else:
+        out = str(tmp_path / "newdir") + os.sep
+    t = time.perf_counter()
+    r = CliRunner().invoke(main, ["run", CASE, "-o", str(out), "--set", "loading.cycles=100000", "--overwrite"])
+    assert r.exit_code == 2 and "Traceback" not in r.output, r.output
+    assert ("symbolic link" if "link" in kind else "names a directory") in r.output
+    assert time.perf_counter() - t < 5
+    assert not (tmp_path / "newdir").exists() and (kind != "link" or target.read_bytes() == b"keep")

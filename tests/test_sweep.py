@@ -197,6 +197,60 @@ def test_a_sweep_killed_mid_way_loses_no_completed_point_and_ends_with_the_same_
         same_arrays(out / "points" / f"{r['point']}.h5", reference / "points" / f"{r['point']}.h5")
 
 
+def _children(pid: int) -> list:
+    """The processes whose parent is ``pid`` (Linux /proc)."""
+    out = []
+    for d in Path("/proc").iterdir():
+        if d.name.isdigit():
+            try:
+                if int((d / "stat").read_text().rsplit(")", 1)[1].split()[1]) == pid:
+                    out.append(int(d.name))
+            except (OSError, IndexError, ValueError):
+                pass
+    return out
+
+
+def _alive(pid: int) -> bool:
+    try:
+        state = (Path("/proc") / str(pid) / "stat").read_text().rsplit(")", 1)[1].split()[0]
+        return state != "Z"
+    except OSError:
+        return False
+
+
+@pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads /proc")
+@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL], ids=["sigterm", "sigkill"])
+def test_a_signalled_sweep_takes_its_workers_with_it(tmp_path, sig):
+    """Only the sweep process is signalled (a batch system's kill, not a terminal's Ctrl-C to the group): its
+    workers used to live on (PPID 1, >100 MB each) holding the caller's stdout, and SIGTERM wrote no table.  Now
+    the workers die with it, the caller's pipe closes, and SIGTERM ends the sweep as Ctrl-C does (exit 130, the
+    table written, the running points interrupted)."""
+    text = SMALL.replace('"output.snapshots=[400]"', '"output.snapshots=[3000]", jumping.scheme=linear, '
+                                                     'jumping.linear=1').replace("loading.cycles=400",
+                                                                                "loading.cycles=3000")
+    path = sweep_file(tmp_path, text)
+    out = tmp_path / "o"
+    proc = subprocess.Popen([sys.executable, "-m", "fretsim", "sweep", str(path), "-o", str(out), "--jobs", "2"],
+                            stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True)
+    deadline = time.monotonic() + 120
+    while time.monotonic() < deadline and not list((out / "points").glob("*.h5")):
+        time.sleep(0.05)
+    workers = _children(proc.pid)
+    assert workers
+    proc.send_signal(sig)
+    output, _ = proc.communicate(timeout=60)  # returns: nobody holds the pipe any more
+    deadline = time.monotonic() + 30
+    while time.monotonic() < deadline and any(_alive(w) for w in workers):
+        time.sleep(0.1)
+    assert not any(_alive(w) for w in workers), output
+    if sig == signal.SIGTERM:
+        assert proc.returncode == 130 and "Traceback" not in output, output
+        statuses = [r["status"] for r in table(out)]
+        assert "interrupted" in statuses, statuses
+    r = CliRunner().invoke(main, ["sweep", str(path), "-o", str(out), "--jobs", "2"])  # and it continues
+    assert r.exit_code == 0, r.output
+
+
 def test_the_same_sweep_on_a_dask_cluster_gives_the_same_table_bit_for_bit(local_sweep):
     distributed = pytest.importorskip("distributed")
     tmp, reference, _ = local_sweep
