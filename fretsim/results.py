@@ -166,6 +166,7 @@ class OutputClaim:
                     self.fd = fd
                     os.ftruncate(fd, 0)
                     os.write(fd, f"{os.getpid()}\n".encode())
+                    _clean_stale_locks(self.lock)
                     return self
             except FileNotFoundError:
                 pass
@@ -186,6 +187,28 @@ class OutputClaim:
 
     def __exit__(self, *exc):
         self.release()
+
+
+def _clean_stale_locks(mine: Path) -> None:
+    """Remove the lock files beside ``mine`` that nobody holds (left by a kill -9: the kernel drops the lock, the
+    file stays).  One a live run holds cannot be locked here and stays; one a run is just claiming it re-checks
+    (the inode test in acquire) and claims again."""
+    try:
+        names = [p for p in mine.parent.glob(".fretsim-*.lock") if p != mine]
+    except OSError:
+        return
+    for p in names[:100]:
+        try:
+            fd = os.open(p, os.O_RDWR)
+        except OSError:
+            continue
+        try:
+            fcntl.flock(fd, fcntl.LOCK_EX | fcntl.LOCK_NB)
+            os.unlink(p)
+        except OSError:
+            pass
+        finally:
+            os.close(fd)
 
 
 def check_output_path(path: str | Path, protect: tuple = ()) -> Path:

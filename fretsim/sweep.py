@@ -314,6 +314,20 @@ def run_sweep(sweep: Sweep, outdir: str | Path, jobs: int = 0, dask: Optional[st
     outdir = Path(outdir)
     (outdir / "points").mkdir(parents=True, exist_ok=True)
     spec_path = outdir / "sweep.json"
+    from fretsim.results import OutputBusy, OutputClaim
+    try:  # the directory is this sweep's, as a results file is its run's: a second sweep is refused, not mixed in
+        claim = OutputClaim(spec_path).acquire()
+    except OutputBusy:
+        raise CaseError(str(outdir), [("", "another fretsim sweep is writing into this directory; wait for it to "
+                                           "finish, or choose another -o")], "sweep directory") from None
+    try:
+        return _run_claimed(sweep, outdir, spec_path, jobs, dask, overwrite, progress)
+    finally:
+        claim.release()
+
+
+def _run_claimed(sweep: Sweep, outdir: Path, spec_path: Path, jobs: int, dask: Optional[str], overwrite: bool,
+                 progress) -> SweepOutcome:
     spec_path.write_text(json.dumps(sweep.spec(), indent=1))
     statuses = {}
     tasks = []

@@ -312,3 +312,32 @@ def test_ctrl_c_stops_a_sweep_at_once_with_its_points_interrupted_and_a_rerun_co
     r = CliRunner().invoke(main, ["sweep", str(path), "-o", str(out), "--jobs", "2"])
     assert r.exit_code == 0, r.output
     assert {row["status"] for row in table(out)} == {"complete"}
+
+
+def test_a_second_sweep_into_a_busy_directory_is_refused_and_changes_nothing(tmp_path):
+    """Two sweeps into one directory used to both exit 3 with points marked refused (each held some points'
+    files), or leave sweep.json describing the other.  The directory is claimed as a run claims its file."""
+    from fretsim.results import OutputClaim
+    out = tmp_path / "o"
+    out.mkdir()
+    (out / "sweep.json").write_text("the first sweep's")
+    with OutputClaim(out / "sweep.json"):
+        r = CliRunner().invoke(main, ["sweep", str(sweep_file(tmp_path)), "-o", str(out)])
+    assert r.exit_code == 2 and "another fretsim sweep" in r.output, r.output
+    assert (out / "sweep.json").read_text() == "the first sweep's" and not list((out / "points").glob("*.h5"))
+
+
+def test_lock_files_left_by_a_kill_9_are_cleaned_by_the_next_claim(tmp_path):
+    import fcntl
+    from fretsim.results import OutputClaim
+    stale = tmp_path / ".fretsim-0123456789abcdef.lock"
+    stale.write_text("4242\n")  # its holder was killed: nobody holds the lock
+    held = tmp_path / ".fretsim-fedcba9876543210.lock"
+    fd = os.open(held, os.O_CREAT | os.O_RDWR)
+    fcntl.flock(fd, fcntl.LOCK_EX)  # a live run's
+    try:
+        with OutputClaim(tmp_path / "r.h5"):
+            assert not stale.exists() and held.exists()
+    finally:
+        os.close(fd)
+    assert held.exists()  # a live run's lock is never removed
