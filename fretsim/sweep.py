@@ -312,6 +312,8 @@ def run_sweep(sweep: Sweep, outdir: str | Path, jobs: int = 0, dask: Optional[st
     """Run every point not yet complete; write the table.  KeyboardInterrupt stops cleanly (the table of what is
     done is written first); a re-run continues."""
     outdir = Path(outdir)
+    if dask:
+        _dask_address(dask)  # a malformed address is refused before anything is written
     (outdir / "points").mkdir(parents=True, exist_ok=True)
     spec_path = outdir / "sweep.json"
     from fretsim.results import OutputBusy, OutputClaim
@@ -395,10 +397,7 @@ def _run_dask(tasks: list, address: str, progress) -> list:
     except ImportError:
         raise CaseError("--dask", [("", "needs Dask's distributed: pip install 'fretsim[dask]'")]) from None
     results = []
-    try:
-        client = Client(address, timeout=DASK_CONNECT_TIMEOUT)
-    except (OSError, TimeoutError) as exc:
-        raise CaseError("--dask", [("", f"cannot reach the scheduler at {address}: {exc}")]) from None
+    client = _connect(Client, address)
     try:
         futures = client.map(run_point_remote, tasks, pure=False)
         for f in as_completed(futures):
@@ -415,6 +414,58 @@ def _run_dask(tasks: list, address: str, progress) -> list:
     finally:
         client.close()
     return results
+
+
+DASK_WORKER_WAIT = 30.0  # s: a scheduler with no workers gets this long to be given one, then it is reported
+
+
+def _dask_address(address: str) -> tuple[str, str, int]:
+    """(scheme://host:port, host, port) of a scheduler address, or a CaseError saying what is expected."""
+    import re
+    m = re.fullmatch(r"(?:(tcp|tls)://)?(\[[0-9a-fA-F:]+\]|[A-Za-z0-9._-]+):(\d{1,5})", address.strip())
+    if not m or not 0 < int(m.group(3)) < 65536:
+        raise CaseError("--dask", [("", f"{address!r} is not a scheduler address; expected tcp://HOST:PORT (or "
+                                         f"HOST:PORT, or tls://HOST:PORT), e.g. tcp://127.0.0.1:8786")])
+    scheme = m.group(1) or "tcp"
+    return f"{scheme}://{m.group(2)}:{m.group(3)}", m.group(2).strip("[]"), int(m.group(3))
+
+
+def _connect(client_class, address: str):
+    """A connected Client, or a CaseError within a bounded time: nothing listening, something that is not a
+    Dask scheduler (it may never answer, or send what Dask reads as a 3 EiB message), or a scheduler without
+    workers."""
+    import socket
+    import threading
+    from dask.utils import parse_timedelta
+    url, host, port = _dask_address(address)
+    limit = float(parse_timedelta(DASK_CONNECT_TIMEOUT))
+    try:
+        socket.create_connection((host, port), timeout=limit).close()
+    except OSError as exc:
+        raise CaseError("--dask", [("", f"cannot reach the scheduler at {url}: {exc.strerror or exc}")]) from None
+    box: dict = {}
+
+    def connect():
+        try:
+            box["client"] = client_class(url, timeout=DASK_CONNECT_TIMEOUT)
+        except BaseException as exc:  # noqa: BLE001 - whatever a foreign service makes Dask raise is reported
+            box["error"] = exc
+    t = threading.Thread(target=connect, daemon=True)
+    t.start()
+    t.join(limit + 5.0)
+    if "client" not in box:
+        why = (f"{type(box['error']).__name__}: {str(box['error'])[:200]}" if "error" in box else
+               f"no answer within {limit + 5:g} s")
+        raise CaseError("--dask", [("", f"something listens at {url}, but no Dask scheduler answered ({why}); "
+                                         f"check the address and the port")])
+    client = box["client"]
+    try:
+        client.wait_for_workers(1, timeout=DASK_WORKER_WAIT)
+    except Exception:  # noqa: BLE001 - dask raises TimeoutError (of its own, or asyncio's)
+        client.close()
+        raise CaseError("--dask", [("", f"the scheduler at {url} has no workers (waited {DASK_WORKER_WAIT:g} s); "
+                                         f"start some, e.g. `dask worker {url}`")]) from None
+    return client
 
 
 def _table_rows(sweep: Sweep, outdir: Path, statuses: dict, stale: frozenset = frozenset()) -> list:

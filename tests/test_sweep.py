@@ -341,3 +341,42 @@ def test_lock_files_left_by_a_kill_9_are_cleaned_by_the_next_claim(tmp_path):
     finally:
         os.close(fd)
     assert held.exists()  # a live run's lock is never removed
+
+
+@pytest.mark.parametrize("address", ["garbage", "http://127.0.0.1:1", "tcp://:", "inproc://x", "tcp://h:99999"])
+def test_a_malformed_dask_address_is_refused_with_what_is_expected(tmp_path, address):
+    pytest.importorskip("distributed")
+    r = CliRunner().invoke(main, ["sweep", str(sweep_file(tmp_path)), "-o", str(tmp_path / "o"), "--dask", address])
+    assert r.exit_code == 2 and "tcp://HOST:PORT" in r.output and "Traceback" not in r.output, r.output
+    assert not (tmp_path / "o").exists()
+
+
+def test_a_port_that_is_not_a_dask_scheduler_is_reported_within_the_timeout(tmp_path, monkeypatch):
+    """It used to wait forever (an HTTP server never answers Dask's handshake; another service may send what Dask
+    reads as a 3 EiB message)."""
+    pytest.importorskip("distributed")
+    import socket
+    import threading
+    import fretsim.sweep
+    monkeypatch.setattr(fretsim.sweep, "DASK_CONNECT_TIMEOUT", "1s")
+    server = socket.socket()
+    server.bind(("127.0.0.1", 0))
+    server.listen(5)
+    held = []
+    threading.Thread(target=lambda: [held.append(server.accept()) for _ in range(5)], daemon=True).start()
+    t = time.perf_counter()
+    r = CliRunner().invoke(main, ["sweep", str(sweep_file(tmp_path)), "-o", str(tmp_path / "o"), "--dask",
+                                  f"127.0.0.1:{server.getsockname()[1]}"])
+    server.close()
+    assert r.exit_code == 2 and "no Dask scheduler answered" in r.output, r.output
+    assert time.perf_counter() - t < 15
+
+
+def test_a_scheduler_without_workers_is_reported_not_waited_on(tmp_path, monkeypatch):
+    distributed = pytest.importorskip("distributed")
+    import fretsim.sweep
+    monkeypatch.setattr(fretsim.sweep, "DASK_WORKER_WAIT", 2.0)
+    with distributed.LocalCluster(n_workers=0, host="127.0.0.1", dashboard_address=None) as cluster:
+        r = CliRunner().invoke(main, ["sweep", str(sweep_file(tmp_path)), "-o", str(tmp_path / "o"), "--dask",
+                                      cluster.scheduler_address])
+    assert r.exit_code == 2 and "has no workers" in r.output, r.output
