@@ -435,7 +435,13 @@ def sweep(sweep_file: Path, outdir: Path, jobs: int, dask_address: str | None, o
         os.environ.setdefault(var, "1")                                        # thread per worker
     from fretsim.sweep import load_sweep, run_sweep
 
-    spec = load_sweep(sweep_file)
+    if dask_address:
+        from fretsim.sweep import check_dask_address
+        check_dask_address(dask_address)  # before seconds of checking points
+
+    def _checking(done, total):  # a large sweep takes seconds to check: say so
+        click.echo(f"checking the sweep's points: {done} of {total}", err=True)
+    spec = load_sweep(sweep_file, progress=_checking)
     failures = {"n": 0}
     bar = None
     if sys.stderr.isatty():

@@ -380,3 +380,21 @@ def test_a_scheduler_without_workers_is_reported_not_waited_on(tmp_path, monkeyp
         r = CliRunner().invoke(main, ["sweep", str(sweep_file(tmp_path)), "-o", str(tmp_path / "o"), "--dask",
                                       cluster.scheduler_address])
     assert r.exit_code == 2 and "has no workers" in r.output, r.output
+
+
+def test_a_large_sweep_is_checked_quickly_and_says_how_far_it_got(tmp_path):
+    """100 000 points used to be checked for over 150 s without a word: the base case is now copied, not deep-copied,
+    and each distinct axis value parsed once (10 000 points: 13 s → 1.4 s measured), with progress every 1 000."""
+    stroke = ", ".join(f"{10 + i * 0.1:.1f} um" for i in range(100))
+    load = ", ".join(f"{100 + i} N" for i in range(100))
+    path = sweep_file(tmp_path, f"base: {CASES / 'mccoll_185N.yaml'}\nset: [model.dimension=2d]\naxes:\n"
+                                f"  loading.stroke: [{stroke}]\n  loading.normal_load: [{load}]\n")
+    seen = []
+    t = time.perf_counter()
+    sweep = load_sweep(path, progress=lambda done, total: seen.append((done, total)))
+    assert len(sweep.points) == 10_000 and seen[0] == (0, 10_000) and seen[-1] == (9_000, 10_000)
+    assert time.perf_counter() - t < 30  # a guard against the old crawl, not a benchmark
+    one = sweep.points[4321]
+    from fretsim.case import parse_case
+    case = parse_case(sweep.base_text, overrides=[*sweep.shared, *one.overrides])
+    assert case.fingerprint() == one.fingerprint  # each point still validated into its own case
