@@ -14,6 +14,7 @@ import functools
 import os
 import sys
 import traceback
+from typing import Optional
 from pathlib import Path
 
 import click
@@ -68,6 +69,30 @@ def main() -> None:
     """
 
 
+LONG_RUN = 60.0  # s: a run expected to take longer says so before it starts
+
+
+def long_run_note(setup) -> Optional[str]:
+    """The cost estimate of a run that will take long by request (ΔN_L = 1 over 10⁹ cycles, msm on a large 3D
+    grid): timed with one solve, so only where the counts alone make it plausible."""
+    from fretsim.plan import estimate_cost, estimate_solves
+    elements = setup.grid.shape[0] * setup.grid.shape[1]
+    if estimate_solves(setup) < 2000 and elements < 20_000 and not (setup.method != "cg" and elements > 2000):
+        return None
+    solves, seconds = estimate_cost(setup)
+    if seconds < LONG_RUN:
+        return None
+    return (f"estimate: about {solves:,} contact solves, {_duration(seconds)} (one timed solve; Ctrl-C stops the "
+            f"run with every step so far written, and --resume continues it)")
+
+
+def _duration(seconds: float) -> str:
+    for unit, size in (("years", 3.156e7), ("days", 86400.0), ("hours", 3600.0), ("minutes", 60.0)):
+        if seconds >= 2 * size:
+            return f"{seconds / size:.3g} {unit}"
+    return f"{seconds:.3g} s"
+
+
 @main.command()
 @click.argument("case_file", required=False, type=click.Path(path_type=Path))
 @click.option("-o", "--output", type=click.Path(),  # text, not a Path: a trailing '/' (a directory) must survive
@@ -101,6 +126,9 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
         if not quiet:
             for note in setup.notes:
                 click.echo(f"note: {note}", err=True)
+            long = long_run_note(setup)
+            if long:
+                click.echo(long, err=True)
         progress.start(setup)
 
     previous_handler = signal.signal(signal.SIGTERM, _terminate)

@@ -104,3 +104,16 @@ def test_the_readmes_case_and_sweep_examples_are_valid_as_printed(tmp_path):
         sweep.parent.mkdir(exist_ok=True)
         sweep.write_text(text)
         assert len(load_sweep(sweep).points) == 20
+
+
+def test_a_run_that_will_take_long_by_request_says_so_before_it_starts():
+    """ΔN_L = 1 over 10⁹ cycles used to start without a word; a default run says nothing extra."""
+    from fretsim.api import load_case
+    from fretsim.cli import long_run_note
+    from fretsim.plan import prepare
+    case = load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", "loading.cycles=1000000000",
+                                                  "jumping.scheme=linear", "jumping.linear=1",
+                                                  "output.snapshots=[1000000000]"])
+    note = long_run_note(prepare(case)[0])
+    assert note is not None and "estimate: about 1,000,000,00" in note and ("years" in note or "days" in note)
+    assert long_run_note(prepare(load_case(CASES / "mccoll_185N.yaml", []))[0]) is None
