@@ -388,6 +388,12 @@ def parse_case(text: str, source: str = "<case>", overrides: Optional[list[str]]
 
 
 def _apply_override(raw: dict, item: str, problems: list) -> None:
+    try:
+        item.encode("utf-8")
+    except UnicodeEncodeError:  # a command line's undecodable bytes, kept by Python as lone surrogates
+        problems.append((f"--set {excerpt(item.encode('utf-8', 'backslashreplace').decode(), 60)}",
+                         "not valid UTF-8 text; the results file stores the case as UTF-8"))
+        return
     key, sep, value = item.partition("=")
     parts = key.strip().split(".")
     if not sep or not key.strip() or not all(parts):

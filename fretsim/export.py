@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import csv
+import os
 from pathlib import Path
 
 import numpy as np
@@ -21,11 +22,20 @@ def export_csv(res: Results, outdir: str | Path) -> list[Path]:
     paths = []
 
     def write(name: str, header: list, rows) -> None:
+        # whole or not at all: beside the target, then renamed over it (a full disk leaves the old file, or none)
         path = outdir / name
-        with open(path, "w", newline="") as fh:
-            w = csv.writer(fh)
-            w.writerow(header)
-            w.writerows(rows)
+        tmp = outdir / f".{name}.{os.getpid()}.part"
+        try:
+            with open(tmp, "w", newline="") as fh:
+                w = csv.writer(fh)
+                w.writerow(header)
+                w.writerows(rows)
+                fh.flush()
+                os.fsync(fh.fileno())
+            os.replace(tmp, path)
+        finally:
+            if tmp.exists():
+                tmp.unlink()
         paths.append(path)
 
     keys = [k for k in res.history if k != "step"]

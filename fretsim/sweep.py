@@ -111,7 +111,8 @@ def load_sweep(path: str | Path, progress: Optional[Callable[[int, int], None]] 
         import yaml
         base_text, base_source = yaml.safe_dump(base, sort_keys=False, allow_unicode=True), f"{source}:base"
     else:
-        problems.append(("base", "missing; expected a case file name or an inline case mapping"))
+        problems.append(("base", ("missing" if base is None else f"got {excerpt(base)}")
+                         + "; expected a case file name or an inline case mapping"))
     shared = raw.get("set", [])
     if not isinstance(shared, list) or not all(isinstance(s, str) and "=" in s for s in shared):
         problems.append(("set", "expected a list of key.path=value overrides, e.g. [model.dimension=2d]"))

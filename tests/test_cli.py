@@ -117,3 +117,10 @@ def test_a_run_that_will_take_long_by_request_says_so_before_it_starts():
     note = long_run_note(prepare(case)[0])
     assert note is not None and "estimate: about 1,000,000,00" in note and ("years" in note or "days" in note)
     assert long_run_note(prepare(load_case(CASES / "mccoll_185N.yaml", []))[0]) is None
+
+
+def test_an_override_that_is_not_utf8_is_refused_not_a_traceback(tmp_path):
+    """A command line's undecodable bytes reach Python as lone surrogates, which h5py cannot store."""
+    r = CliRunner().invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), "--set", "name=a\udc80b", "-o",
+                                  str(tmp_path / "r.h5")])
+    assert r.exit_code == 2 and "not valid UTF-8" in r.output and not (tmp_path / "r.h5").exists(), r.output

@@ -284,3 +284,32 @@ def test_the_layers_keep_their_import_rules():
     for f in MODULES.rglob("*.py"):
         if f.name != "plotting.py":
             assert not any(m.startswith("matplotlib") for m in _imports(f)), f
+
+
+def test_export_to_a_full_disk_leaves_whole_files_or_none(results_3d, tmp_path, monkeypatch):
+    """A full disk used to leave a truncated history.csv that looked like a shorter run."""
+    import csv as csv_module
+    import errno
+    import fretsim.export
+    out = tmp_path / "csv"
+    assert CliRunner().invoke(main, ["export", str(results_3d), "--csv", str(out)]).exit_code == 0
+    before = {p.name: p.read_bytes() for p in out.iterdir()}
+    real = csv_module.writer
+
+    class Filling:
+        def __init__(self, fh):
+            self.w, self.fh = real(fh), fh
+
+        def writerow(self, row):
+            self.w.writerow(row)
+
+        def writerows(self, rows):
+            for i, row in enumerate(rows):
+                if i == 3:
+                    raise OSError(errno.ENOSPC, "No space left on device")
+                self.w.writerow(row)
+
+    monkeypatch.setattr(fretsim.export.csv, "writer", Filling)
+    r = CliRunner().invoke(main, ["export", str(results_3d), "--csv", str(out)])
+    assert r.exit_code != 0 and "Traceback" not in r.output and "space" in r.output.lower(), r.output
+    assert {p.name: p.read_bytes() for p in out.iterdir()} == before  # the earlier export whole, no partial file

@@ -398,3 +398,9 @@ def test_a_large_sweep_is_checked_quickly_and_says_how_far_it_got(tmp_path):
     from fretsim.case import parse_case
     case = parse_case(sweep.base_text, overrides=[*sweep.shared, *one.overrides])
     assert case.fingerprint() == one.fingerprint  # each point still validated into its own case
+
+
+def test_a_base_that_is_not_a_file_name_is_named_for_what_it_is(tmp_path):
+    r = CliRunner().invoke(main, ["sweep", str(sweep_file(tmp_path, "base: 5\naxes:\n  loading.stroke: [10 um]\n")),
+                                  "-o", str(tmp_path / "o")])
+    assert r.exit_code == 2 and "base: got 5" in r.output, r.output
