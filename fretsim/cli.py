@@ -140,6 +140,9 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
             case = load_case(case_file, list(overrides))
             outcome = run_case(case, output, overwrite=overwrite, progress=progress.update, on_plan=_on_plan)
     except KeyboardInterrupt:
+        if _status_of(output) == "complete":  # the interrupt came after the last write
+            click.echo(f"interrupted after the run had completed: {output} holds the whole run (status 'complete')")
+            return
         raise Fail(f"interrupted; every accepted step so far is in {output} (status 'interrupted'); continue with "
                    f"`fretsim run --resume {output}`", EXIT_INTERRUPTED) from None
     except OSError as exc:  # before any step: the output's place cannot be written
@@ -159,6 +162,14 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
         raise Fail(f"run failed: {outcome.message}" + (f"; steps up to the failure are in {output} (status 'failed')"
                                                        if outcome.written else ""), EXIT_FAILED)
     click.echo(_paragraph(outcome))
+
+
+def _status_of(path) -> Optional[str]:
+    from fretsim.results import read_results
+    try:
+        return read_results(path).status
+    except (ValueError, OSError):
+        return None
 
 
 class _Progress:

@@ -236,6 +236,7 @@ def _execute(setup, filled, plan, output, overwrite, progress, observers, resume
         finally:
             _restore_signals(previous)
         raise
+    previous = _ignore_signals()  # a Ctrl-C in the last instant must not make a complete run look interrupted
     try:
         _finish(writer, setup, counter, t0, status, message)
     except ResultsIOError as exc:
@@ -244,6 +245,8 @@ def _execute(setup, filled, plan, output, overwrite, progress, observers, resume
                                    f"'running'); when there is room, continue with `fretsim run --resume {output}`",
                        _summary(setup, counter, t0), setup, filled, Path(output), counter.last, setup.notes, plan,
                        True)
+    finally:
+        _restore_signals(previous)
     return Outcome(status, message, _summary(setup, counter, t0), setup, filled, Path(output) if output else None,
                    counter.last, setup.notes, plan, writer is not None)
 

@@ -479,3 +479,21 @@ def test_an_output_that_cannot_be_the_results_file_is_refused_before_the_run(tmp
     assert ("symbolic link" if "link" in kind else "names a directory") in r.output
     assert time.perf_counter() - t < 5
     assert not (tmp_path / "newdir").exists() and (kind != "link" or target.read_bytes() == b"keep")
+
+
+def test_ctrl_c_in_the_last_instant_does_not_call_a_complete_run_interrupted(tmp_path, monkeypatch):
+    """8 of 10 Ctrl-C in the last instant used to report `interrupted` for a file whose status was `complete`,
+    whose --resume then refused.  The final write ignores a Ctrl-C, and one that lands after it is reported as
+    what it is."""
+    import fretsim.api
+    real = fretsim.api.run
+
+    def finished_then_interrupted(*a, **k):
+        real(*a, **k)
+        raise KeyboardInterrupt
+    monkeypatch.setattr(fretsim.api, "run", finished_then_interrupted)
+    out = tmp_path / "r.h5"
+    r = CliRunner().invoke(main, ["run", CASE, "--set", "model.dimension=2d", "--set", "loading.cycles=300", "-o",
+                                  str(out)])
+    assert r.exit_code == 0 and "had completed" in r.output, r.output
+    assert read_results(out).status == "complete"
