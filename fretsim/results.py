@@ -851,6 +851,10 @@ def read_sweep_table(directory: str | Path) -> SweepTable:
                 ds = f[k]
                 axes[k] = [v.decode() if isinstance(v, bytes) else v for v in ds[()].tolist()]
                 units[k] = _text(ds.attrs.get("units", ""))
+                bad = [v for v in axes[k] if isinstance(v, float) and not (math.isfinite(v) and abs(v) < 1e30)]
+                if bad:
+                    raise ValueError(f"table.h5: the axis {k} holds {bad[0]!r}, which no sweep writes (damaged?); "
+                                     f"run the sweep again to rewrite its table")
             for k, ds in f.items():
                 if isinstance(ds, h5py.Dataset) and k in SUMMARY_UNITS:
                     units[k] = _text(ds.attrs.get("units", ""))

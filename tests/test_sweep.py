@@ -404,3 +404,16 @@ def test_a_base_that_is_not_a_file_name_is_named_for_what_it_is(tmp_path):
     r = CliRunner().invoke(main, ["sweep", str(sweep_file(tmp_path, "base: 5\naxes:\n  loading.stroke: [10 um]\n")),
                                   "-o", str(tmp_path / "o")])
     assert r.exit_code == 2 and "base: got 5" in r.output, r.output
+
+
+@pytest.mark.parametrize("values", [(float("nan"), 1e308), (-1e308, 1e308)], ids=["nan", "huge"])
+def test_plotting_a_sweep_whose_table_axis_is_damaged_is_refused_not_a_traceback(local_sweep, tmp_path, values):
+    import h5py
+    import shutil
+    tmp, out, _ = local_sweep
+    copy = tmp_path / "copy"
+    shutil.copytree(out, copy)
+    with h5py.File(copy / "table.h5", "r+") as f:
+        f["loading.stroke"][0], f["loading.stroke"][1] = values
+    r = CliRunner().invoke(main, ["plot", str(copy), "-o", str(tmp_path / "figs")])
+    assert r.exit_code == 2 and "loading.stroke" in r.output and "Traceback" not in r.output, r.output
