@@ -108,7 +108,11 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "poissons_ratio": Key("number", "Poisson's ratio ν", REQUIRED, lo=-1.0, hi=0.5, example="0.3"),
         "wear_coefficient": Key("wear_coefficient", "Archard wear coefficient k (Eqs. 14–16; includes hardness); "
                                                     "required with model.wear_law archard", None,
-                                plausible=(0.0, 1e-3, "0 to 1e-3 1/MPa"), positive=False, example="2.0e-8 1/MPa"),
+                                # 1e-4 1/MPa is 0.1 mm³/(N·m): a hundred times the fastest-wearing polymers; beyond,
+                                # the wear of one cycle outruns the elastic contact (k_s 1e-3 stopped a 2D run at
+                                # cycle 1 and crawled in 3D)
+                                plausible=(0.0, 1e-4, "0 to 1e-4 1/MPa (0.1 mm3/(N·m))"), positive=False,
+                                example="2.0e-8 1/MPa"),
         "energy_wear_coefficient": Key("energy_wear_coefficient", "energy wear coefficient α (Fouvry): worn volume "
                                                                   "per dissipated energy, dh = α·|q|·|ds|; "
                                                                   "required with model.wear_law energy", None,
