@@ -525,11 +525,15 @@ def write_table(sweep: Sweep, rows: list, outdir: Path) -> tuple[Path, Path]:
     csv_path, h5_path = outdir / "table.csv", outdir / "table.h5"
     keys = list(dict.fromkeys(k for r in rows for k in r))
     tmp = outdir / ".table.csv.part"
-    with open(tmp, "w", newline="") as fh:
-        w = csv.DictWriter(fh, fieldnames=keys)
-        w.writeheader()
-        w.writerows(rows)
-    os.replace(tmp, csv_path)
+    try:
+        with open(tmp, "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=keys)
+            w.writeheader()
+            w.writerows(rows)
+        os.replace(tmp, csv_path)
+    finally:
+        if tmp.is_file():  # a failed write leaves no temporary behind
+            tmp.unlink()
     outputs = [k for k in SUMMARY_UNITS if any(k in r for r in rows)]
     tmp = outdir / ".table.h5.part"
     with h5py.File(tmp, "w") as f:

@@ -157,7 +157,13 @@ def validate(names: list[str], outdir: Path, jobs: int = 0, quick: bool = False,
                 progress(1)
     outdir.mkdir(parents=True, exist_ok=True)
     report = build_report(cases, results, outdir, quick)
-    (outdir / "report.md").write_text(report)
+    tmp = outdir / f".report.md.{os.getpid()}.part"  # whole or not at all: a full disk keeps the last report
+    try:
+        tmp.write_text(report)
+        os.replace(tmp, outdir / "report.md")
+    finally:
+        if tmp.exists():
+            tmp.unlink()
     return {"results": results, "report": outdir / "report.md",
             "ok": all(r.get("status") == "complete" for r in results.values())}
 

@@ -417,3 +417,26 @@ def test_plotting_a_sweep_whose_table_axis_is_damaged_is_refused_not_a_traceback
         f["loading.stroke"][0], f["loading.stroke"][1] = values
     r = CliRunner().invoke(main, ["plot", str(copy), "-o", str(tmp_path / "figs")])
     assert r.exit_code == 2 and "loading.stroke" in r.output and "Traceback" not in r.output, r.output
+
+
+def test_a_table_that_cannot_be_written_leaves_no_temporary_and_says_why(tmp_path):
+    out = tmp_path / "o"
+    (out / "table.csv").mkdir(parents=True)  # a directory where the table belongs
+    r = CliRunner().invoke(main, ["sweep", str(sweep_file(tmp_path)), "-o", str(out)])
+    assert r.exit_code in (2, 5) and "table.csv" in r.output and "Traceback" not in r.output, r.output
+    assert not [p.name for p in out.iterdir() if p.name.endswith(".part")]
+
+
+def test_two_sweeps_started_together_into_one_directory_never_mix(tmp_path):
+    """One runs, the other is refused (or finds the work done); the table is the one sweep's, whole."""
+    path = sweep_file(tmp_path)
+    out = tmp_path / "o"
+    procs = [subprocess.Popen([sys.executable, "-m", "fretsim", "sweep", str(path), "-o", str(out), "--jobs", "1"],
+                              stdout=subprocess.PIPE, stderr=subprocess.STDOUT, text=True) for _ in range(2)]
+    outputs = [p.communicate(timeout=300)[0] for p in procs]
+    codes = sorted(p.returncode for p in procs)
+    assert codes in ([0, 0], [0, 2]), (codes, outputs)
+    if codes == [0, 2]:
+        assert any("another fretsim sweep" in o for o in outputs), outputs
+    assert {r["status"] for r in table(out)} == {"complete"} and len(table(out)) == 4
+    assert not any("Traceback" in o for o in outputs)
