@@ -36,7 +36,7 @@ def available() -> list[str]:
 def _unit(spec: Key) -> str:
     if spec.kind in INTERNAL:
         return {"length": "m, mm, um (µm), nm", "force": "N, kN, mN", "pressure": "Pa … GPa",
-                "wear_coefficient": "1/MPa, 1/Pa, mm2/N, m2/N", "energy_wear_coefficient": "mm3/J, um3/J, m3/J",
+                "wear_coefficient": "1/MPa, mm3/(N·m), 1/Pa, mm2/N, m2/N", "energy_wear_coefficient": "mm3/J, um3/J, m3/J",
                 "stiffness": "N/mm, N/um, kN/mm, N/m"}[spec.kind]
     return {"fraction": "% or a fraction", "integer": "–", "number": "–", "choice": "–", "lengths": "lengths",
             "counts": "–", "cycle_list": "cycles"}.get(spec.kind, "–")

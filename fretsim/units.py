@@ -18,8 +18,10 @@ UNITS: dict[str, dict[str, float]] = {
     "length": {"km": 1e6, "m": 1e3, "mm": 1.0, "um": 1e-3, "µm": 1e-3, "micron": 1e-3, "nm": 1e-6, "cm": 10.0},
     "force": {"N": 1.0, "kN": 1e3, "MN": 1e6, "mN": 1e-3, "uN": 1e-6, "µN": 1e-6},
     "pressure": {"Pa": 1e-6, "kPa": 1e-3, "MPa": 1.0, "GPa": 1e3, "N/mm2": 1.0, "N/mm^2": 1.0},
-    "wear_coefficient": {"1/MPa": 1.0, "1/Pa": 1e6, "1/GPa": 1e-3, "mm2/N": 1.0, "mm^2/N": 1.0, "m2/N": 1e6,
-                         "m^2/N": 1e6},
+    # Archard's k with the hardness in it: 1/MPa = mm²/N = mm³/(N·mm); tribologists quote the specific wear rate
+    # in mm³/(N·m) (volume per load and sliding distance), a thousandth of it
+    "wear_coefficient": {"1/MPa": 1.0, "mm3/(N*m)": 1e-3, "1/Pa": 1e6, "mm2/N": 1.0, "m2/N": 1e6, "1/GPa": 1e-3,
+                         "mm^2/N": 1.0, "m^2/N": 1e6, "mm3/Nm": 1e-3, "mm3/(N*mm)": 1.0, "m3/(N*m)": 1e6},
     # worn volume per dissipated energy (Fouvry's α): 1 J = 1000 N·mm
     "energy_wear_coefficient": {"mm3/J": 1e-3, "mm^3/J": 1e-3, "um3/J": 1e-12, "µm3/J": 1e-12, "µm^3/J": 1e-12,
                                 "m3/J": 1e6, "m^3/J": 1e6, "mm3/Nm": 1e-3, "mm3/(N*m)": 1e-3, "mm3/(N*mm)": 1.0},
@@ -28,7 +30,15 @@ UNITS: dict[str, dict[str, float]] = {
 INTERNAL = {"length": "mm", "force": "N", "pressure": "MPa", "wear_coefficient": "1/MPa",
             "energy_wear_coefficient": "mm3/(N*mm)", "stiffness": "N/mm"}
 
-_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf|nan)\s*(\S+)\s*$", re.IGNORECASE)
+_QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf|nan)\s*(\S.*?)\s*$", re.IGNORECASE)
+_TYPESET = str.maketrans({"·": "*", "⋅": "*", "×": "*", "³": "3", "²": "2", "^": None})
+
+
+def _plain_unit(unit: str) -> str:
+    """A unit as typed or typeset — mm³/(N·m), mm^3/(N m) — in the tables' spelling, mm3/(N*m): a space between
+    two symbols is a product, any other is dropped."""
+    unit = re.sub(r"(?<=[\w)])\s+(?=[\w(])", "*", unit.strip())
+    return re.sub(r"\s+", "", unit).translate(_TYPESET)
 
 
 class UnitError(ValueError):
@@ -53,6 +63,11 @@ def parse_quantity(value: object, dimension: str) -> float:
     if not m:
         raise UnitError(f"could not read {_short(value)}; expected {expected}")
     number, unit = float(m.group(1)), m.group(2)
+    if re.fullmatch(r"[\d.eE+-]+", unit):  # '25' read as 2 and '5'
+        raise UnitError(f"got the bare number {_short(value)} without a unit; expected {expected}")
+    plain = {_plain_unit(k): v for k, v in table.items()}
+    if unit not in table and _plain_unit(unit) in plain:
+        table, unit = plain, _plain_unit(unit)
     if unit not in table:
         for dim, other in UNITS.items():
             if unit in other and dim != dimension:

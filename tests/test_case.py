@@ -107,3 +107,17 @@ def test_numbers_written_without_a_dot_are_accepted():
 def test_missing_file_is_a_case_error(tmp_path):
     with pytest.raises(CaseError, match="does not exist"):
         load_case(tmp_path / "nope.yaml")
+
+
+@pytest.mark.parametrize("text", ["2e-5 mm3/(N*m)", "2e-5 mm³/(N·m)", "2e-5 mm^3/(N m)", "2e-8 mm3/(N*mm)",
+                                  "2e-14 1/Pa", "2e-14 m2/N", "2e-5 mm3/Nm"])
+def test_the_specific_wear_rate_tribologists_quote_is_read_in_any_spelling(text):
+    """mm³/(N·m) is volume per load and sliding distance in metres: a thousandth of 1/MPa (= mm³/(N·mm))."""
+    from fretsim.units import parse_quantity
+    assert parse_quantity(text, "wear_coefficient") == pytest.approx(2e-8, rel=1e-12)
+
+
+def test_a_quoted_number_without_a_unit_is_called_that():
+    from fretsim.units import UnitError, parse_quantity
+    with pytest.raises(UnitError, match="bare number '25'"):
+        parse_quantity("25", "length")
