@@ -312,6 +312,8 @@ def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> N
 
     from fretsim.results import read_results, summary_json
 
+    if as_json and as_csv:
+        raise Fail("--json and --csv are two formats of the same figures; choose one")
     rows, bad = [], []
     for path in results_files:
         try:

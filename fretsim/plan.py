@@ -177,8 +177,9 @@ def choose_gap_model(case: Case, grid: Grid) -> Choice:
     if case.gap_model != "auto":
         return Choice("model.gap", case.gap_model, "given in the case", True)
     if stable:
-        return Choice("model.gap", "mid_stroke", "the paper's model (Eq. 18): stable here, since k_m ≥ "
-                                                 f"{-min(b_min, 0):.3f}·k_s")
+        bound = -min(b_min, 0.0)
+        return Choice("model.gap", "mid_stroke", "the paper's model (Eq. 18): stable here, since "
+                      + (f"k_m ≥ {bound:.3g}·k_s" if bound > 0 else "it is stable for any k_m and k_s on this grid"))
     return Choice("model.gap", "stroke_average",
                   f"the paper's mid-stroke gap is unstable when the moving body wears less than "
                   f"{-b_min:.3f} of the flat (k_m = {k_m:.3g}, k_s = {k_s:.3g} 1/MPa): wear modes shorter than "
@@ -708,7 +709,7 @@ def _check_model_growth(case: Case, gap_model: str, spectrum: Spectrum, plan: Pl
     if growth > MODEL_GROWTH:
         raise CaseError(case.source, [("model.gap", f"the paper's mid-stroke gap is unstable for these wear "
                                                     f"coefficients (the moving body wears too little): its "
-                                                    f"fastest wear mode grows {rate:.3g}-fold per cycle, "
+                                                    f"fastest wear mode grows by {rate:.3g} of itself per cycle, "
                                                     f"e^{growth:.0f} over the run. Use model.gap: auto (or "
                                                     f"stroke_average), which is stable")])
     plan.warnings.append(f"the mid-stroke gap model is unstable here (growth rate {rate:.3g} per cycle), but "

@@ -345,7 +345,7 @@ class _Loop:
         if reach_x >= lim.reach_x or (lim.reach_y is not None and reach_y >= lim.reach_y):
             r = max(lim.reach_x, lim.reach_y or 0)
             raise PhysicalLimit(f"the contact reached {max(reach_x, reach_y):.4g} mm from the centre at cycle "
-                                f"{self.n} (wear depth {depth * 1e3:.4g} µm), half the radius {2 * r:.4g} mm: beyond "
+                                f"{self.n} (wear depth {depth * 1e3:.4g} µm), half of the radius of {2 * r:.4g} mm: beyond "
                                 f"it the body's worn shape is no longer the paraboloid this model assumes", self.n)
 
     def advance(self, dh_m, dh_s, d_n: int, d_work: float) -> None:

@@ -112,5 +112,7 @@ def template_text(kind: str) -> str:
                 out.append(f"  {key + ': ' + example:<29} # {spec.help}")
             else:
                 shown = "auto" if spec.default is None else spec.default
+                if spec.default is None and spec.choices and "auto" not in spec.choices:
+                    shown = spec.choices[0]  # `auto` is not one of its values: show one that is
                 out.append(f"  # {key + ': ' + str(shown):<27} # {spec.help}")
     return "\n".join(out) + "\n"

@@ -124,3 +124,25 @@ def test_an_override_that_is_not_utf8_is_refused_not_a_traceback(tmp_path):
     r = CliRunner().invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), "--set", "name=a\udc80b", "-o",
                                   str(tmp_path / "r.h5")])
     assert r.exit_code == 2 and "not valid UTF-8" in r.output and not (tmp_path / "r.h5").exists(), r.output
+
+
+@pytest.mark.parametrize("kind", ["cylinder_on_flat", "ball_on_flat", "crossed_cylinders", "tube_on_flat",
+                                  "roller_on_flat"])
+def test_every_commented_line_of_a_template_parses_when_uncommented(kind):
+    """The templates commented `scheme: auto` and `preset: auto`, which the parser refuses."""
+    from fretsim.case import parse_case
+    from fretsim.templates import template_text
+    lines = template_text(kind).splitlines()
+    for i, line in enumerate(lines):
+        if line.startswith("  # ") and ":" in line:
+            text = "\n".join(lines[:i] + [line.replace("# ", "", 1)] + lines[i + 1:])
+            if "profile:" in line:  # names a CSV file the template does not ship
+                continue
+            parse_case(text)
+
+
+def test_summary_refuses_two_formats_at_once(tmp_path):
+    from fretsim.api import load_case, run
+    run(load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", "loading.cycles=10"]), tmp_path / "r.h5")
+    r = CliRunner().invoke(main, ["summary", str(tmp_path / "r.h5"), "--json", "--csv"])
+    assert r.exit_code == 2 and "choose one" in r.output, r.output

@@ -290,7 +290,7 @@ def test_wearing_through_the_geometry_stops_with_exit_4(tmp_path):
     r = CliRunner().invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), "-o", str(tmp_path / "p.h5"), "--set",
                                   "model.dimension=2d", "--set", "loading.cycles=10000000000", "--set",
                                   "materials.moving.wear_coefficient=1e-4 1/MPa"])
-    assert r.exit_code == 4 and "half the radius" in r.output
+    assert r.exit_code == 4 and "half of the radius" in r.output
     res = read_results(tmp_path / "p.h5")
     assert res.status == "stopped" and res.history["cycle"][-1] < 10**10
 
