@@ -131,7 +131,10 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
                 click.echo(long, err=True)
         progress.start(setup)
 
-    previous_handler = signal.signal(signal.SIGTERM, _terminate)
+    try:
+        previous_handler = signal.signal(signal.SIGTERM, _terminate)
+    except ValueError:  # not the main thread (the CLI called from a thread): SIGTERM keeps its handler
+        previous_handler = None
     outcome = None
     try:
         if resume_file is not None:
@@ -499,7 +502,9 @@ def sweep(sweep_file: Path, outdir: Path, jobs: int, dask_address: str | None, o
     def _terminate(signum, frame):  # SIGTERM ends a sweep as Ctrl-C does: points interrupted, the table written
         raise KeyboardInterrupt
     import signal
-    signal.signal(signal.SIGTERM, _terminate)
+    import threading
+    if threading.current_thread() is threading.main_thread():  # (a sweep started from a thread cannot)
+        signal.signal(signal.SIGTERM, _terminate)
     try:
         out = run_sweep(spec, outdir, jobs, dask_address, overwrite, _progress)
     except KeyboardInterrupt:
