@@ -277,6 +277,13 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
     cells = f"{g.shape[1]} elements of {g.dx * 1e3:.4g} µm" if g.plane_strain else \
         f"{g.shape[1]} × {g.shape[0]} elements of {g.dx * 1e3:.4g} × {g.dy * 1e3:.4g} µm"
     click.echo(f"{filled.name}: {filled.cycles} cycles, {filled.dimension.upper()} {filled.geometry.kind}, {cells}")
+    from fretsim.reference import effective_modulus
+    e_star = effective_modulus(filled.moving.youngs_modulus, filled.moving.poissons_ratio,
+                               filled.stationary.youngs_modulus, filled.stationary.poissons_ratio)
+    h = filled.geometry.hertz(filled.normal_load, e_star)
+    click.echo(f"unworn contact (Hertz): peak pressure p0 = {h.peak_pressure:.4g} MPa, half-width a = "
+               f"{h.half_width_x * 1e3:.4g} µm" + ("" if h.line else f" × {h.half_width_y * 1e3:.4g} µm")
+               + f", E* = {e_star / 1e3:.4g} GPa")
     click.echo(f"explicit stability limit: {setup.stability_limit:.4g} cycles (solve grid, gap model {filled.gap_model})")
     if filled.friction_coefficient is not None:
         d_t = setup.gross_slip_stroke

@@ -32,6 +32,8 @@ MEMORY_SHARE = 0.5  # refuse a grid that would take more than this share of the 
 MODEL_GROWTH = math.log(1e3)  # a forced unstable model may grow a seed at most 1000-fold over the run
 SHORT_RUN = 8  # runs of at most this many cycles are taken a cycle at a time: exact, and as cheap
 MIN_ELEMENTS_ACROSS_CONTACT = 4
+ELASTIC_P0 = 0.04  # p0/E* beyond which no metal stays elastic (bearing steel: ~4 GPa over E* = 115 GPa, 3.5 %)
+SMALL_CONTACT = 0.1  # a/R beyond which the half-space (small-strain) contact model is said to be stretched
 
 
 @dataclass(frozen=True)
@@ -384,8 +386,25 @@ def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0) -> t
                                            f"{case.stroke / hertz.half_width_x:.0f} times the Hertz contact "
                                            f"half-width ({hertz.half_width_x:.3g} mm); fretting is a small "
                                            f"oscillation (up to {MAX_STROKE_OVER_CONTACT:g} a here): check its unit"))
+    reach = g.limits.reach_x
+    if hertz.half_width_x >= reach:
+        problems.append(("loading.normal_load", f"the unworn contact alone (Hertz half-width {hertz.half_width_x:.4g} "
+                                                f"mm under {case.normal_load:.4g} N) reaches beyond {reach:.4g} mm, "
+                                                f"half the body's radius, where its paraboloid (Eqs. 9–10) stops "
+                                                f"describing it: no elastic contact model holds; check the load "
+                                                f"and the radius and their units"))
     if problems:
         raise CaseError(case.source, problems)
+    p0_ratio = hertz.peak_pressure / e_star
+    if p0_ratio > ELASTIC_P0:
+        plan.warnings.append(f"the Hertz peak pressure p0 = {hertz.peak_pressure:.4g} MPa is {p0_ratio:.1%} of the "
+                             f"contact modulus E* = {e_star:.4g} MPa: well beyond the yield of the softer body for "
+                             f"any metal (hardened bearing steel stays elastic to about 4 GPa, 3.5 % of its E*); the "
+                             f"elastic model is out of its range, check the load and the moduli")
+    if hertz.half_width_x > SMALL_CONTACT * reach * 2:
+        plan.warnings.append(f"the Hertz half-width a = {hertz.half_width_x:.4g} mm is {hertz.half_width_x / (2 * reach):.0%}"
+                             f" of the radius: the half-space model assumes a ≪ R (beyond about "
+                             f"{SMALL_CONTACT:.0%} its pressures are off by more than a few per cent)")
     dimension = plan.add(choose_dimension(case, e_star))
     plane = dimension == "2d"
     if plane and g.axial_profile:

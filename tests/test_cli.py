@@ -146,3 +146,16 @@ def test_summary_refuses_two_formats_at_once(tmp_path):
     run(load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", "loading.cycles=10"]), tmp_path / "r.h5")
     r = CliRunner().invoke(main, ["summary", str(tmp_path / "r.h5"), "--json", "--csv"])
     assert r.exit_code == 2 and "choose one" in r.output, r.output
+
+
+def test_check_shows_hertz_and_refuses_or_warns_where_the_elastic_model_cannot_hold():
+    """5 MN on a 5 mm ball (a half-width beyond the ball) and 1.7 GPa on aluminium used to pass `check` silently."""
+    r = CliRunner().invoke(main, ["check", str(CASES / "ball_partial_slip.yaml"), "--set", "loading.normal_load=5 MN",
+                                  "--set", "geometry.radius=5 mm"])
+    assert r.exit_code == 2 and "loading.normal_load" in r.output and "half the body's radius" in r.output, r.output
+    r = CliRunner().invoke(main, ["check", str(CASES / "ball_partial_slip.yaml"), "--set",
+                                  "loading.normal_load=3000 N", "--set", "materials.moving.youngs_modulus=70 GPa",
+                                  "--set", "materials.stationary.youngs_modulus=70 GPa"])
+    assert r.exit_code == 0 and "peak pressure p0 = 1746 MPa" in r.output and "out of its range" in r.output
+    r = CliRunner().invoke(main, ["check", str(CASES / "mccoll_185N.yaml")])
+    assert "unworn contact (Hertz)" in r.output and "out of its range" not in r.output
