@@ -584,21 +584,22 @@ class Results:
         return self.attrs.get("status", "")
 
     def to_xarray(self):
-        """The fields as an xarray Dataset over (cycle, y, x) with units, the history as another over step.
-
-        Returns ``(fields, history)``; needs xarray (``pip install xarray``).
-        """
+        """The run as one xarray Dataset: the fields over (cycle, y, x) at the recorded states, the history over
+        ``step`` (every accepted step, with its cycle as the coordinate ``step_cycle``), units on every variable,
+        and the summary as attributes.  Needs xarray (``pip install xarray``)."""
         import xarray as xr
-        coords = {"cycle": ("cycle", self.fields["cycle"], {"units": "cycles"}), "y": ("y", self.y, {"units": "mm"}),
-                  "x": ("x", self.x, {"units": "mm"})}
-        fields = xr.Dataset({k: (("cycle", "y", "x"), v, {"units": self.units.get(f"fields/{k}", "")})
-                             for k, v in self.fields.items() if k != "cycle"}, coords=coords,
-                            attrs={"case_name": self.attrs.get("case_name", ""), "status": self.status})
-        history = xr.Dataset({k: ("step", v, {"units": self.units.get(f"history/{k}", "")})
-                              for k, v in self.history.items() if k not in ("cycle", "step")},
-                             coords={"step": np.arange(len(self.history["cycle"])),
-                                     "cycle": ("step", self.history["cycle"], {"units": "cycles"})})
-        return fields, history
+        coords = {"cycle": ("cycle", self.fields["cycle"], {"units": "cycles", "long_name": "recorded state"}),
+                  "y": ("y", self.y, {"units": "mm"}), "x": ("x", self.x, {"units": "mm"}),
+                  "step": ("step", np.arange(len(self.history["cycle"])), {"long_name": "accepted step"}),
+                  "step_cycle": ("step", self.history["cycle"], {"units": "cycles",
+                                                                 "long_name": "cycle of the accepted step"})}
+        data = {k: (("cycle", "y", "x"), v, {"units": self.units.get(f"fields/{k}", "")})
+                for k, v in self.fields.items() if k != "cycle"}
+        data.update({k: ("step", v, {"units": self.units.get(f"history/{k}", "")})
+                     for k, v in self.history.items() if k not in ("cycle", "step")})
+        attrs = {"case_name": self.attrs.get("case_name", ""), "status": self.status}
+        attrs.update({k: v for k, v in self.summary.items() if isinstance(v, (int, float, str))})
+        return xr.Dataset(data, coords=coords, attrs=attrs)
 
 
 class _Damaged(ResultsFileError):

@@ -47,11 +47,18 @@ def test_xarray_opens_the_fields_labelled_with_units_and_no_phony_dimensions(res
     assert summ.cycles.attrs["units"] == "cycles" and int(summ.cycles) == 1000
 
 
-def test_to_xarray_gives_the_same_labelled_fields(results_3d):
+def test_to_xarray_gives_one_labelled_dataset_and_the_readmes_example_runs(results_3d):
+    """It returned a (fields, history) tuple, so the README's `ds = res.to_xarray()` then `ds.wear_depth_…` failed."""
     pytest.importorskip("xarray")
-    fields, history = read_results(results_3d).to_xarray()
-    assert fields.pressure.dims == ("cycle", "y", "x") and list(fields.cycle.values) == [0, 500, 1000]
-    assert history.cycle.attrs["units"] == "cycles"
+    res = read_results(results_3d)
+    ds = res.to_xarray()
+    assert ds.pressure.dims == ("cycle", "y", "x") and list(ds.cycle.values) == [0, 500, 1000]
+    assert ds.wear_depth_stationary.attrs["units"] == "um"
+    assert ds.max_wear_depth_stationary.dims == ("step",) and ds.step_cycle.attrs["units"] == "cycles"
+    assert np.array_equal(ds.step_cycle.values, res.history["cycle"])
+    assert ds.attrs["max_wear_depth_stationary_um"] == res.summary["max_wear_depth_stationary_um"]
+    profile = ds.wear_depth_stationary.sel(cycle=1000).sel(y=0, method="nearest")  # as the README shows
+    assert np.array_equal(profile.values, res.fields["wear_depth_stationary"][-1][res.y.size // 2])
 
 
 def test_inputs_and_overrides_are_recorded_in_the_file_and_in_summary_json(results_3d):
