@@ -539,6 +539,8 @@ class _Reader:
         raise AssertionError(kind)
 
     def quantity(self, value: Any, spec: Key, path: str) -> Optional[float]:
+        if path == "loading.stroke" and isinstance(value, str) and value.lstrip().startswith(("±", "+/-")):
+            value = value.lstrip().removeprefix("±").removeprefix("+/-")  # an amplitude, as the figures print it
         try:
             v = parse_quantity(value, spec.kind)
         except UnitError as exc:

@@ -337,8 +337,15 @@ def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> N
         click.echo(json.dumps(rows[0] if len(rows) == 1 else rows, indent=2, allow_nan=False))
     elif as_csv:
         import csv
-        flat = [{**{k: v for k, v in r.items() if not isinstance(v, (dict, list))},
-                 **{f"input_{k}": v for k, v in r.get("inputs", {}).items()},
+        def inputs(r):  # each input with a column of its unit beside it (the names users' scripts read stay)
+            out = {}
+            for k, v in r.get("inputs", {}).items():
+                out[f"input_{k}"] = v
+                unit = r.get("input_units", {}).get(k)
+                if unit and unit != "1":
+                    out[f"input_{k}_units"] = unit
+            return out
+        flat = [{**{k: v for k, v in r.items() if not isinstance(v, (dict, list))}, **inputs(r),
                  "overrides": " ".join(r.get("overrides", []))} for r in rows]
         keys = list(dict.fromkeys(k for r in flat for k in r))
         w = csv.DictWriter(sys.stdout, fieldnames=keys)
@@ -351,7 +358,8 @@ def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> N
             for k, v in data.items():
                 click.echo(f"{k:<{width}}  {v:.6g}" if isinstance(v, float) else f"{k:<{width}}  {v}")
             if r.get("inputs"):
-                click.echo("inputs  " + ", ".join(f"{k} {v}{' ' + r['input_units'][k] if r['input_units'].get(k) and r['input_units'][k] != '1' else ''}"
+                click.echo("inputs  " + ", ".join(f"{k} {f'{v:.6g}' if isinstance(v, float) else v}"
+                                                  f"{' ' + r['input_units'][k] if r['input_units'].get(k) and r['input_units'][k] != '1' else ''}"
                                                   for k, v in r["inputs"].items()))
             if r.get("overrides"):
                 click.echo("overrides  " + " ".join(r["overrides"]))

@@ -121,3 +121,11 @@ def test_a_quoted_number_without_a_unit_is_called_that():
     from fretsim.units import UnitError, parse_quantity
     with pytest.raises(UnitError, match="bare number '25'"):
         parse_quantity("25", "length")
+
+
+def test_a_stroke_written_as_the_figures_print_it_is_its_amplitude():
+    from pathlib import Path
+    CASES = Path(__file__).resolve().parent.parent / "cases"  # noqa: N806
+    a = load_case(CASES / "mccoll_185N.yaml", ["loading.stroke=±25 um"]).stroke
+    b = load_case(CASES / "mccoll_185N.yaml", ["loading.stroke=+/-25 um"]).stroke
+    assert a == b == load_case(CASES / "mccoll_185N.yaml").stroke

@@ -75,6 +75,7 @@ def test_summary_of_several_files_as_csv_has_one_row_each_with_inputs(results_3d
     r = CliRunner().invoke(main, ["summary", str(results_3d), str(other), "--csv"])
     rows = list(csv.DictReader(r.output.splitlines()))
     assert [float(row["input_normal_load"]) for row in rows] == [185.0, 150.0]
+    assert rows[0]["input_normal_load_units"] == "N" and rows[0]["input_stroke_units"] == "um"  # no unit guessed
     assert rows[1]["overrides"] == "model.dimension=2d loading.cycles=200 loading.normal_load=150 N"
 
 
