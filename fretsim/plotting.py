@@ -1,7 +1,7 @@
 """Figures from a results file (the only module importing matplotlib; Agg backend, no display).
 
 After the paper: wear profiles across the contact (Fig. 17) and, in 3D, along it; pressure profiles (Fig. 16)
-with the initial Hertz solution; wear maps of both bodies on one colour scale (Figs. 24–25) and the pressure
+with the initial Hertz solution; wear maps of both bodies, each on its own round colour scale (Figs. 24–25), and the pressure
 map (the finite cylinder's end peaks, Fig. 5); maximum depth and wear volume against cycles (Figs. 14, 28)
 with Archard's line and a marker at every contact solve.  They read only the results file: :func:`figures`
 returns the matplotlib figures (tests check what is drawn), :func:`plot_all` saves them.
@@ -230,7 +230,15 @@ def _pressure(res: Results):
         if three_d:
             ax = axes[1, col]
             ix = res.x.size // 2
-            _snapshot_lines(ax, res.y, [d[:, ix] for d in data], labels)
+            along = [d[:, ix] for d in data]
+            _snapshot_lines(ax, res.y, along, labels)
+            if worn.any() and (~worn).any():  # clipped as across x: the unworn peak would flatten the worn curves
+                top = 1.25 * max(r.max() for r, w in zip(along, worn) if w)
+                peak = max(r.max() for r, w in zip(along, worn) if not w)
+                if peak > top:
+                    ax.set_ylim(0, top)
+                    ax.annotate(f"N = 0 peak {peak:.4g} {unit} (off scale)", xy=(0.02, 0.95),
+                                xycoords="axes fraction", fontsize=8, va="top")
             ax.set_xlabel("y, across the sliding direction (mm)")
             ax.set_ylabel(f"contact pressure ({unit})")
             short = what.split(" (")[0]
@@ -241,31 +249,44 @@ def _pressure(res: Results):
     return fig
 
 
+def _nice_levels(vmax: float) -> np.ndarray:
+    """Contour levels at round values from 0 to at least ``vmax`` (ticks like 0, 0.5, 1 … not 0.462, 14.77 …)."""
+    if not vmax > 0:
+        return np.linspace(0.0, 1.0, 11)
+    ticks = MaxNLocator(nbins=10, steps=[1, 2, 2.5, 5, 10]).tick_values(0.0, vmax)
+    ticks = ticks[ticks >= 0]
+    return ticks if ticks[-1] >= vmax else np.append(ticks, ticks[-1] + (ticks[1] - ticks[0]))
+
+
 def _maps(res: Results):
-    """Final wear of both bodies on one colour scale, and the final pressure."""
+    """Final wear of each body on its own colour scale (an aluminium ball's 98.5 µm no longer darkens a steel
+    flat's 4.9 µm), and the final pressure; round contour levels; a note where x and y are drawn to different
+    scales."""
     cycles = res.fields["cycle"]
     last = len(cycles) - 1
     wear = [res.fields[f"wear_depth_{b}"][last] for b in ("moving", "stationary")]
-    vmax = max(float(w.max()) for w in wear) or 1.0
-    fig = plt.figure(figsize=(15, 4.8))
-    gs = fig.add_gridspec(1, 6, width_ratios=[1, 1, 0.045, 0.28, 1, 0.045], wspace=0.08)
-    axes = [fig.add_subplot(gs[0, i]) for i in (0, 1, 4)]
-    bars = [fig.add_subplot(gs[0, i]) for i in (2, 5)]
-    levels = np.linspace(0.0, vmax, 21)
-    for ax, body, w in zip(axes[:2], ("moving", "stationary"), wear):
-        cs = ax.contourf(res.x, res.y, w, levels=levels, cmap="viridis", extend="neither")
-        ax.set_title(f"{body} body wear, {_cycles_label(cycles[last])}")
-    axes[1].tick_params(labelleft=False)
-    fig.colorbar(cs, cax=bars[0], label=f"wear depth ({_unit(res, 'fields/wear_depth_moving')}), one scale")
+    fig = plt.figure(figsize=(16, 4.8))
+    gs = fig.add_gridspec(1, 8, width_ratios=[1, 0.045, 0.3, 1, 0.045, 0.3, 1, 0.045], wspace=0.08)
+    axes = [fig.add_subplot(gs[0, i]) for i in (0, 3, 6)]
+    bars = [fig.add_subplot(gs[0, i]) for i in (1, 4, 7)]
+    unit = _unit(res, "fields/wear_depth_moving")
+    for ax, bar, body, w in zip(axes[:2], bars[:2], ("moving", "stationary"), wear):
+        cs = ax.contourf(res.x, res.y, w, levels=_nice_levels(float(w.max())), cmap="viridis", extend="neither")
+        ax.set_title(f"{body} body wear, {_cycles_label(cycles[last])} (max {float(w.max()):.3g} {unit})")
+        fig.colorbar(cs, cax=bar, label=f"wear depth ({unit}), this body's scale")
     p = res.fields["pressure"][last]
-    pc = axes[2].contourf(res.x, res.y, p, levels=21, cmap="magma")
-    fig.colorbar(pc, cax=bars[1], label=f"contact pressure ({_unit(res, 'fields/pressure')})")
+    pc = axes[2].contourf(res.x, res.y, p, levels=_nice_levels(float(p.max())), cmap="magma")
+    fig.colorbar(pc, cax=bars[2], label=f"contact pressure ({_unit(res, 'fields/pressure')})")
     axes[2].set_title(f"pressure on the moving body, {_cycles_label(cycles[last])}")
+    lx = float(res.x[-1] - res.x[0]) if res.x.size > 1 else 1.0
+    ly = float(res.y[-1] - res.y[0]) if res.y.size > 1 else 0.0
     for ax in axes:
         ax.set_xlabel("x, sliding direction (mm)")
         ax.xaxis.set_major_locator(MaxNLocator(5))
-    axes[0].set_ylabel("y (mm)")
-    axes[2].set_ylabel("y (mm)")
+        ax.set_ylabel("y (mm)")
+    if ly > 0 and not 0.5 < ly / lx < 2:
+        fig.text(0.5, 0.005, f"x and y are drawn to different scales: the maps span {lx:.3g} mm along x and "
+                             f"{ly:.3g} mm along y ({max(ly / lx, lx / ly):.0f}:1)", ha="center", fontsize=8)
     return fig
 
 
