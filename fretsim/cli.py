@@ -397,7 +397,9 @@ def plot(results_file: Path, outdir: Path | None, fmt: str, dpi: int, log_cycles
         return
 
     res = read_results(results_file)
-    from fretsim.plotting import plot_all
+    from fretsim.plotting import plot_all, skipped
+    for why in skipped(res):
+        click.echo(f"note: {why}", err=True)
     jobs = jobs or (2 if (os.cpu_count() or 1) > 1 else 1)
     _write_and_list(lambda: plot_all(res, outdir or results_file.parent, fmt=fmt, dpi=dpi, log_cycles=log_cycles,
                                      jobs=jobs), "figures")
@@ -455,7 +457,7 @@ def init(kind: str, output: Path | None) -> None:
 @click.argument("cases", nargs=-1)
 @click.option("-o", "--outdir", type=click.Path(file_okay=False, path_type=Path), default=Path("validation"),
               show_default=True, help="Directory for report.md and its figures.")
-@click.option("--jobs", type=click.IntRange(0, 256), default=0, help="Parallel runs (default: the number of cores).")
+@click.option("--jobs", type=click.IntRange(0, 256), default=0, help="Parallel runs; 0 (the default): the number of cores.")
 @click.option("--quick", is_flag=True, help="Line contacts in 2D and point contacts short: the check in a minute.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
 @_boundary
@@ -479,7 +481,7 @@ def validate(cases: tuple, outdir: Path, jobs: int, quick: bool, debug: bool) ->
 @click.argument("sweep_file", type=click.Path(path_type=Path))
 @click.option("-o", "--outdir", type=click.Path(file_okay=False, path_type=Path), required=True,
               help="Directory for the points' results files and the table.")
-@click.option("--jobs", type=click.IntRange(0, 1024), default=0, help="Local worker processes (default: the cores).")
+@click.option("--jobs", type=click.IntRange(0, 1024), default=0, help="Local worker processes; 0 (the default): the number of cores.")
 @click.option("--dask", "dask_address", metavar="tcp://HOST:PORT", help="Run the points on this Dask scheduler.")
 @click.option("--overwrite", is_flag=True, help="Run every point again, complete ones too.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")

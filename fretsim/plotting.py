@@ -85,11 +85,24 @@ def _builders(res: Results, log_cycles: bool) -> dict:
     out = {"pressure_profiles": lambda: _pressure(res)}
     if (res.fields["cycle"] > 0).any():
         out["wear_profiles"] = lambda: _profiles(res)
+    if (res.history["cycle"] > 0).any():  # every accepted step is in the history, recorded states or not
         out["history"] = lambda: _history(res, log_cycles)
     if res.y.size > 1:
         out["maps"] = lambda: _maps(res)
     if res.fretting_loop.get("displacement") is not None and res.fretting_loop["displacement"].size:
         out["fretting"] = lambda: _fretting(res)
+    return out
+
+
+def skipped(res: Results) -> list[str]:
+    """What the file cannot draw, and why (for the CLI to say, not to leave out silently)."""
+    out = []
+    if not (res.fields["cycle"] > 0).any():
+        last = int(res.history["cycle"][-1]) if res.history["cycle"].size else 0
+        out.append(f"no wear profiles: the file's only recorded state is cycle 0 (status {res.status}, its last "
+                   f"step cycle {last}); recorded states are the case's output.snapshots and the last cycle")
+    if res.y.size == 1:
+        out.append("no maps: a 2D run has one row")
     return out
 
 

@@ -337,3 +337,31 @@ def test_each_bodys_wear_map_has_its_own_round_scale_and_the_y_profiles_are_clip
     along_y = figs["pressure_profiles"].axes[2]
     worn_peak = max(float(d[:, res.x.size // 2].max()) for d in res.fields["pressure"][1:])
     assert along_y.get_ylim()[1] <= 1.25 * worn_peak + 1e-9 < float(res.fields["pressure"][0].max())
+
+
+def test_plot_of_a_run_interrupted_before_its_first_recorded_state_says_what_it_cannot_draw(tmp_path):
+    """It skipped two figures silently; the history is drawn from the steps, and the wear profiles' absence is said."""
+    out = tmp_path / "i.h5"
+    run(load_case(CASE, ["model.dimension=2d", "loading.cycles=2000", "output.snapshots=[0, 2000]"]), out)
+    with h5py.File(out, "r+") as f:  # as an interrupted run leaves it: steps past cycle 0, no state recorded yet
+        cyc = f["fields/cycle"][()]
+        for k in list(f["fields"].keys()):
+            ds = f[f"fields/{k}"]
+            if ds.ndim == 3 and ds.shape[0] == cyc.size:
+                data, attrs = ds[()][:1], dict(ds.attrs)
+                del f[f"fields/{k}"]
+                f.create_dataset(f"fields/{k}", data=data).attrs.update(
+                    {a: v for a, v in attrs.items() if a not in ("DIMENSION_LIST", "REFERENCE_LIST")})
+        del f["fields/cycle"]
+        f.create_dataset("fields/cycle", data=cyc[:1])
+        for k in ("cycle", "displacement", "tangential_force"):
+            if f"fretting_loop/{k}" in f:
+                data = f[f"fretting_loop/{k}"][()][:1]
+                del f[f"fretting_loop/{k}"]
+                f.create_dataset(f"fretting_loop/{k}", data=data)
+        f.attrs["status"] = "interrupted"
+        from fretsim.results import _seal
+        _seal(f)
+    r = CliRunner().invoke(main, ["plot", str(out), "-o", str(tmp_path / "figs"), "--jobs", "1"])
+    assert r.exit_code == 0 and "no wear profiles" in r.output, r.output
+    assert {p.name for p in (tmp_path / "figs").iterdir()} == {"i_pressure_profiles.png", "i_history.png"}
