@@ -430,8 +430,24 @@ def export(results_file: Path, csv_dir: Path, debug: bool) -> None:
     _write_and_list(lambda: export_csv(res, csv_dir), str(csv_dir))
 
 
-@main.command()
-@click.argument("kind", required=False, default="mccoll_185N")
+class _InitCommand(click.Command):
+    """`init --help` lists what it accepts, read when asked (not at start-up, which every sweep point pays)."""
+
+    def format_epilog(self, ctx, formatter):
+        from fretsim.templates import GEOMETRY_KEYS, shipped
+        with formatter.section("Shipped cases"):
+            formatter.write_text(", ".join(shipped()))
+        with formatter.section("Geometry templates"):
+            formatter.write_text(", ".join(GEOMETRY_KEYS))
+
+
+def _complete_kind(ctx, param, incomplete):
+    from fretsim.templates import available
+    return [k for k in available() if k.startswith(incomplete)]
+
+
+@main.command(cls=_InitCommand)
+@click.argument("kind", required=False, default="mccoll_185N", shell_complete=_complete_kind)
 @click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
               help="Where to write the case (default: KIND.yaml in the current directory).")
 @_boundary

@@ -159,3 +159,10 @@ def test_check_shows_hertz_and_refuses_or_warns_where_the_elastic_model_cannot_h
     assert r.exit_code == 0 and "peak pressure p0 = 1746 MPa" in r.output and "out of its range" in r.output
     r = CliRunner().invoke(main, ["check", str(CASES / "mccoll_185N.yaml")])
     assert "unworn contact (Hertz)" in r.output and "out of its range" not in r.output
+
+
+def test_init_help_lists_the_shipped_cases_and_templates_and_completion_offers_them():
+    r = CliRunner().invoke(main, ["init", "--help"])
+    assert "mccoll_185N" in r.output and "ball_partial_slip" in r.output and "roller_on_flat" in r.output
+    from fretsim.cli import _complete_kind
+    assert "mccoll_1670N" in _complete_kind(None, None, "mccoll_1") and _complete_kind(None, None, "zz") == []
