@@ -503,13 +503,17 @@ def _table_rows(sweep: Sweep, outdir: Path, statuses: dict, stale: frozenset = f
 
 
 def _numeric_axis(values: list):
-    """Axis values as numbers in the internal unit with that unit, when they are one kind of quantity."""
-    for dim, table in UNITS.items():
+    """Axis values as numbers in the unit they were written in (the first value's, where they mix units), with
+    that unit, when they are one kind of quantity: a stroke of [10 um, 25 um] is 10 and 25 µm, not 0.01 mm."""
+    from fretsim.units import _QUANTITY
+    for dim in UNITS:
         try:
-            return [parse_quantity(v, dim) for v in values], {"length": "mm", "force": "N", "pressure": "MPa",
-                                                               "wear_coefficient": "1/MPa"}[dim]
+            internal = [parse_quantity(v, dim) for v in values]
         except UnitError:
             continue
+        unit = _QUANTITY.match(str(values[0])).group(2)
+        scale = parse_quantity(f"1 {unit}", dim)
+        return [v / scale for v in internal], unit
     if all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in values):
         return [float(v) for v in values], "1"
     return None, None

@@ -107,7 +107,8 @@ def test_the_table_opens_in_xarray_with_the_axes_as_coordinates(local_sweep):
     ds = xr.open_dataset(out / "table.h5", engine="h5netcdf")
     d = ds.centre_wear_depth_stationary_um
     assert d.dims == ("loading.normal_load", "loading.stroke")
-    assert list(ds["loading.stroke"].values) == [0.01, 0.025] and ds["loading.stroke"].attrs["units"] == "mm"
+    # in the unit the sweep file wrote (it was 0.01, 0.025 mm: the internal unit)
+    assert list(ds["loading.stroke"].values) == [10.0, 25.0] and ds["loading.stroke"].attrs["units"] == "um"
 
 
 def test_re_running_a_sweep_skips_complete_points(local_sweep):
@@ -441,3 +442,16 @@ def test_two_sweeps_started_together_into_one_directory_never_mix(tmp_path):
         assert any("another fretsim sweep" in o for o in outputs), outputs
     assert {r["status"] for r in table(out)} == {"complete"} and len(table(out)) == 4
     assert not any("Traceback" in o for o in outputs)
+
+
+def test_a_sweep_over_any_kind_of_quantity_keeps_its_written_unit(tmp_path):
+    """An axis of stiffnesses used to end the sweep with a KeyError after every point had run (its table's unit
+    was looked up among four kinds only)."""
+    xr = pytest.importorskip("xarray")
+    text = SMALL.replace("axes:\n  loading.normal_load: [150 N, 185 N]\n  loading.stroke: [10 um, 25 um]\n",
+                         "axes:\n  loading.tangential_stiffness: [40 N/um, 80000 N/mm]\n")
+    r = CliRunner().invoke(main, ["sweep", str(sweep_file(tmp_path, text)), "-o", str(tmp_path / "o")])
+    assert r.exit_code == 0, r.output
+    ds = xr.open_dataset(tmp_path / "o" / "table.h5", engine="h5netcdf")
+    axis = ds["loading.tangential_stiffness"]
+    assert list(axis.values) == [40.0, 80.0] and axis.attrs["units"] == "N/um"  # the first value's unit
