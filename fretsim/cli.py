@@ -372,7 +372,7 @@ def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> N
 
 
 @main.command()
-@click.argument("results_file", type=click.Path(path_type=Path))
+@click.argument("results_files", nargs=-1, required=True, type=click.Path(path_type=Path))
 @click.option("-o", "--outdir", type=click.Path(file_okay=False, path_type=Path),
               help="Directory for the figures (default: next to RESULTS_FILE, or in a sweep's directory).")
 @click.option("--format", "fmt", type=click.Choice(["png", "pdf", "svg"]), default="png", show_default=True)
@@ -380,14 +380,27 @@ def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> N
 @click.option("--log", "log_cycles", is_flag=True, help="Logarithmic cycle axis for the histories.")
 @click.option("--jobs", type=click.IntRange(1, 2), default=None,
               help="Processes rendering the figures: 2 on a machine with 2 or more cores (default), else 1.")
+@click.option("--expected", is_flag=True,
+              help="Overlay each case's published values (its `expected:` data: experiment, FEA, the paper).")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
 @_boundary
-def plot(results_file: Path, outdir: Path | None, fmt: str, dpi: int, log_cycles: bool, jobs: int | None,
-         debug: bool) -> None:
+def plot(results_files: tuple, outdir: Path | None, fmt: str, dpi: int, log_cycles: bool, jobs: int | None,
+         expected: bool, debug: bool) -> None:
     """Write figures of RESULTS_FILE: wear profiles across and along the contact, wear and pressure maps,
-    pressure profiles with the initial Hertz solution, depth and volume against cycles.  Given a sweep's
-    directory: response curves, each output against each swept axis, one line per value of the others."""
+    pressure profiles with the initial Hertz solution, depth and volume against cycles.  Given several files
+    (or --expected): one overlay.png of their worn profiles and depth histories on common axes.  Given a
+    sweep's directory: response curves, each output against each swept axis, one line per value of the others."""
     from fretsim.results import read_results
+
+    if len(results_files) > 1 or expected:
+        if any(p.is_dir() for p in results_files):
+            raise Fail("overlaying takes results files, not a sweep's directory (plot that alone)")
+        runs = [read_results(p) for p in results_files]
+        from fretsim.plotting import plot_overlay
+        _write_and_list(lambda: plot_overlay(runs, outdir or results_files[0].parent, expected, fmt, dpi),
+                        "the overlay")
+        return
+    results_file = results_files[0]
 
     if results_file.is_dir():
         from fretsim.results import read_sweep_table
@@ -416,7 +429,7 @@ def _write_and_list(write, what: str) -> None:
 
 
 @main.command()
-@click.argument("results_file", type=click.Path(path_type=Path))
+@click.argument("results_files", nargs=-1, required=True, type=click.Path(path_type=Path))
 @click.option("--csv", "csv_dir", required=True, type=click.Path(file_okay=False, path_type=Path),
               help="Directory for history.csv, summary.csv, inputs.csv and fields.csv.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")

@@ -173,6 +173,96 @@ def plot_all(res: Results, outdir: str | Path, fmt: str = "png", dpi: int = 150,
     return [paths[n] for n in names]
 
 
+EXPECTED_MARKERS = {"experiment": "o", "fea": "s", "paper": "^"}
+
+
+def _expected_depths(res: Results) -> dict:
+    """source → (centre depth of the flat µm, its scar width mm) from the case's `expected:` data (None: absent)."""
+    from fretsim.case import parse_case
+    from fretsim.units import UnitError, parse_quantity
+    try:
+        expected = parse_case(res.case_yaml).expected or {}
+    except Exception:  # noqa: BLE001 - a file whose case no longer parses simply has nothing to compare with
+        return {}
+    out = {}
+    for source, values in expected.items():
+        if not isinstance(values, dict):
+            continue
+        got = []
+        for key in ("centre_wear_depth_stationary", "scar_width_stationary"):
+            try:
+                got.append(parse_quantity(values[key], "length") if key in values else None)
+            except UnitError:
+                got.append(None)
+        if any(v is not None for v in got):
+            out[source] = (got[0] * 1e3 if got[0] is not None else None, got[1])
+    return out
+
+
+def overlay(results: list, expected: bool = False):
+    """Several runs on one figure, as the paper compares RT with 90 °C and runs with and without jumping: the
+    final worn profiles of both bodies across the contact, and each body's maximum depth against cycles; with
+    ``expected``, each case's published values (experiment, FEA, the paper) as markers."""
+    fig, axes = plt.subplots(2, 2, figsize=(12, 8), squeeze=False)
+    shown = set()  # published values are the case's: drawn once per case, in black
+    for k, res in enumerate(results):
+        label = f"{res.attrs.get('case_name', '')} ({Path(res.path).stem})"
+        colour = f"C{k % 10}"
+        last = len(res.fields["cycle"]) - 1
+        for col, body in enumerate(("stationary", "moving")):
+            row = centre_row(res.fields[f"wear_depth_{body}"][last])
+            axes[0, col].plot(res.x, -row, color=colour, label=f"{label}, {_cycles_label(res.fields['cycle'][last])}")
+            axes[1, col].plot(res.history["cycle"], res.history[f"max_wear_depth_{body}"], color=colour,
+                              marker=".", ms=3, label=label)
+        name = res.attrs.get("case_name", "")
+        if expected and name not in shown:
+            shown.add(name)
+            for source, (depth, width) in _expected_depths(res).items():
+                m = EXPECTED_MARKERS.get(source, "x")
+                text = f"{source}, {name}: " + ", ".join(
+                    t for t in (f"{depth:.3g} µm deep" if depth is not None else "",
+                                f"scar {width:.3g} mm" if width is not None else "") if t)
+                if depth is not None:
+                    axes[0, 0].plot([0.0], [-depth], m, color="k", mfc="none", ms=8, label=text)
+                    axes[1, 0].plot([res.fields["cycle"][last]], [depth], m, color="k", mfc="none", ms=8, label=text)
+                if width is not None:  # the scar's edges, at the surface
+                    axes[0, 0].plot([-width / 2, width / 2], [0.0, 0.0], m, color="k", mfc="none", ms=8,
+                                    label=None if depth is not None else text)
+    units = _unit(results[0], "fields/wear_depth_stationary")
+    for col, body in enumerate(("stationary", "moving")):
+        axes[0, col].set_xlabel("x, sliding direction (mm)")
+        axes[0, col].set_ylabel(f"worn profile at y = 0, −depth ({units})")
+        axes[0, col].set_title(f"{body} body, last recorded state")
+        axes[1, col].set_xlabel("cycles")
+        axes[1, col].set_ylabel(f"maximum depth ({units})")
+        axes[1, col].set_title(f"{body} body, every accepted step")
+    for ax in axes.ravel():
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle(f"{len(results)} run(s) overlaid" + ("; markers: published values (case `expected:`)"
+                                                        if expected else ""), fontsize=9)
+    fig.subplots_adjust(left=0.07, right=0.98, bottom=0.07, top=0.93, hspace=0.32, wspace=0.22)
+    return fig
+
+
+def plot_overlay(results: list, outdir: str | Path, expected: bool = False, fmt: str = "png",
+                 dpi: int = 150) -> list[Path]:
+    """Save :func:`overlay` as OUTDIR/overlay.FMT, whole or not at all."""
+    outdir = Path(outdir)
+    outdir.mkdir(parents=True, exist_ok=True)
+    path = outdir / f"overlay.{fmt}"
+    tmp = outdir / f".overlay.{os.getpid()}.tmp"
+    fig = overlay(results, expected)
+    try:
+        fig.savefig(tmp, dpi=dpi, format=fmt)
+        os.replace(tmp, path)
+    finally:
+        plt.close(fig)
+        if tmp.exists():
+            tmp.unlink()
+    return [path]
+
+
 def _profiles(res: Results):
     """Wear profiles of both bodies at every worn snapshot: across the contact (y = 0) and, in 3D, along it."""
     cycles = res.fields["cycle"]

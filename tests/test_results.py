@@ -365,3 +365,29 @@ def test_plot_of_a_run_interrupted_before_its_first_recorded_state_says_what_it_
     r = CliRunner().invoke(main, ["plot", str(out), "-o", str(tmp_path / "figs"), "--jobs", "1"])
     assert r.exit_code == 0 and "no wear profiles" in r.output, r.output
     assert {p.name for p in (tmp_path / "figs").iterdir()} == {"i_pressure_profiles.png", "i_history.png"}
+
+
+def test_plot_overlays_several_runs_and_the_published_values(results_3d, tmp_path):
+    """The paper's figures put several runs and the experiment or FEA on one plot; `plot` took one file."""
+    from fretsim.plotting import overlay
+    other = tmp_path / "o.h5"
+    run(load_case(CASE, ["model.dimension=2d", "loading.cycles=1000"]), other)
+    r = CliRunner().invoke(main, ["plot", str(results_3d), str(other), "--expected", "-o", str(tmp_path / "figs")])
+    assert r.exit_code == 0 and (tmp_path / "figs" / "overlay.png").exists(), r.output
+    runs = [read_results(results_3d), read_results(other)]
+    fig = overlay(runs, expected=True)
+    profile = fig.axes[0]
+    drawn = [ln for ln in profile.lines if ln.get_linestyle() == "-"]
+    assert len(drawn) == 2
+    for ln, res in zip(drawn, runs):
+        assert np.allclose(ln.get_ydata(), -centre_row_of(res))
+    published = {ln.get_label().split(",")[0]: -ln.get_ydata()[0] for ln in profile.lines
+                 if ln.get_label().startswith(("experiment", "fea", "paper"))}
+    assert published == pytest.approx({"experiment": 2.9, "fea": 3.0, "paper": 3.0})  # µm, from the case file
+    history = fig.axes[2]
+    assert np.array_equal(history.lines[0].get_xdata(), runs[0].history["cycle"])
+
+
+def centre_row_of(res):
+    from fretsim.plotting import centre_row
+    return centre_row(res.fields["wear_depth_stationary"][-1])
