@@ -124,6 +124,10 @@ def run_one(args: tuple) -> dict:
     row = {"name": name, "status": out.status, "message": out.message, "seconds": seconds,
            "summary": dict(out.summary), "dimension": out.case.dimension, "overrides": list(overrides),
            "choices": [(c.key, str(c.value), c.reason) for c in (out.plan.choices if out.plan else []) if not c.given]}
+    if out.last is not None and out.last.cycle > 0:  # the flat's final profile along y = 0, for the report's figure
+        from fretsim.simulate import centre_line
+        row["profile_x_mm"] = out.setup.grid.x.tolist()
+        row["profile_stationary_um"] = (centre_line(out.last.wear_stationary) * 1e3).tolist()
     if out.last is not None and out.last.cycle == 0:
         g = out.setup.grid
         p = out.last.pressure
@@ -226,6 +230,10 @@ def build_report(cases: dict, results: dict, outdir: Path, quick: bool) -> str:
                          f"{'–' if mw is None else f'{mw:.1f} %'} | {len(pairs[g]['width'])} |")
         lines += ["", "![Table 4](table4.png)", ""]
         _table4_figure(table4, cases, results, outdir / "table4.png")
+        if _profiles_figure(table4, cases, results, outdir / "profiles.png"):
+            lines += ["Each case's worn flat along y = 0 (fretsim, this run) against its published depth (at the centre) "
+                      "and scar width (its edges at the surface): experiment ○, FEA □, the paper △.", "",
+                      "![profiles](profiles.png)", ""]
     table1 = [n for n, (_, e) in cases.items() if e and "contact_half_width" in e.values.get("paper", {})]
     if table1:
         lines += ["## Table 1: the unworn contact and the converged element size", "",
@@ -280,6 +288,47 @@ def build_report(cases: dict, results: dict, outdir: Path, quick: bool) -> str:
             if key in ("model.dimension", "model.gap", "model.corrections", "jumping.scheme"):
                 lines.append(f"- {n}: {key} = {value}: {reason}")
     return "\n".join(lines) + "\n"
+
+
+def _profiles_figure(names: list[str], cases: dict, results: dict, path: Path) -> bool:
+    """A panel per case: fretsim's worn flat across the contact and the published depth and width as markers."""
+    drawn = [n for n in names if results[n].get("profile_stationary_um")]
+    if not drawn:
+        return False
+    import matplotlib
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+    cols = min(4, len(drawn))
+    rows = -(-len(drawn) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3.2 * rows), squeeze=False)
+    for ax, n in zip(axes.ravel(), drawn):
+        res, ev = results[n], cases[n][1].values
+        ax.plot(res["profile_x_mm"], [-v for v in res["profile_stationary_um"]], "C0-", label="fretsim")
+        for group, marker in (("experiment", "o"), ("fea", "s"), ("paper", "^")):
+            depth = ev.get(group, {}).get("centre_wear_depth_stationary")
+            width = ev.get(group, {}).get("scar_width_stationary")
+            if depth is not None:
+                ax.plot([0.0], [-depth], marker, color="k", mfc="none", label=group)
+            if width is not None:
+                ax.plot([-width / 2, width / 2], [0.0, 0.0], marker, color="k", mfc="none",
+                        label=None if depth is not None else group)
+        ax.set_title(f"{n} ({res.get('dimension', '?')})", fontsize=9)
+        ax.set_xlabel("x (mm)", fontsize=8)
+        ax.set_ylabel("−depth (µm)", fontsize=8)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=6)
+    for ax in axes.ravel()[len(drawn):]:
+        ax.set_visible(False)
+    fig.tight_layout()
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        fig.savefig(tmp, dpi=110, format="png")
+        os.replace(tmp, path)
+    finally:
+        plt.close(fig)
+        if tmp.exists():
+            tmp.unlink()
+    return True
 
 
 def _table4_figure(names: list[str], cases: dict, results: dict, path: Path) -> None:

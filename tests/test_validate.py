@@ -48,6 +48,10 @@ def test_quick_validation_reports_against_experiment_fea_and_paper_reading_each_
     assert "| 2.7 |" in row and "| 2D |" in row
     assert "MAPE against experiment" in report and (tmp_path / "v" / "table4.png").exists()
     assert "| table1_case1 | 0.036 |" in report
+    # each case's worn profile drawn against its published depth and width (the file's 2.7 µm for 185 N)
+    assert "![profiles](profiles.png)" in report and (tmp_path / "v" / "profiles.png").exists()
+    profile = out["results"]["mccoll_185N"]["profile_stationary_um"]
+    assert max(profile) == pytest.approx(out["results"]["mccoll_185N"]["summary"]["centre_wear_depth_stationary_um"])
 
 
 def test_validate_refuses_an_unknown_case_name():
