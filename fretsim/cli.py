@@ -131,6 +131,11 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
                 click.echo(long, err=True)
         progress.start(setup)
 
+    import time as _time
+    import fretsim.plan as plan_module
+    started = _time.perf_counter()
+    if not quiet:  # auto's proxy runs can take a minute before the first step: say what is running
+        plan_module.announce = lambda what: click.echo(f"[{_time.perf_counter() - started:5.1f} s] {what}", err=True)
     try:
         previous_handler = signal.signal(signal.SIGTERM, _terminate)
     except ValueError:  # not the main thread (the CLI called from a thread): SIGTERM keeps its handler
@@ -270,9 +275,15 @@ def _paragraph(outcome) -> str:
 def check(case_file: Path, overrides: tuple, debug: bool) -> None:
     """Resolve CASE_FILE without running it: the filled case, the grid, every choice with its reason, the
     stability limit, an estimate of the solves and time, and every warning."""
+    import time
+
+    import fretsim.plan as plan_module
     from fretsim.api import check as check_case, load_case
 
+    started = time.perf_counter()
+    plan_module.announce = lambda what: click.echo(f"[{time.perf_counter() - started:5.1f} s] {what}", err=True)
     setup, filled, plan = check_case(load_case(case_file, list(overrides)))
+    planning = time.perf_counter() - started
     g = setup.grid
     cells = f"{g.shape[1]} elements of {g.dx * 1e3:.4g} µm" if g.plane_strain else \
         f"{g.shape[1]} × {g.shape[0]} elements of {g.dx * 1e3:.4g} × {g.dy * 1e3:.4g} µm"
@@ -293,7 +304,9 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
                    f"{filled.friction_coefficient:g}, the unworn contact)")
     from fretsim.plan import estimate_cost
     solves, seconds = estimate_cost(setup)
-    click.echo(f"estimate: about {solves} contact solves, {seconds:.2g} s")
+    click.echo(f"estimate: about {solves} contact solves, {seconds:.2g} s"
+               + (f", after {planning:.2g} s of planning (auto's proxy runs, which a run repeats)"
+                  if planning > 1.0 else "") + f" (jumping.tolerance {filled.step_tolerance:g})")
     click.echo("choices:")
     width = max(len(c.key) for c in plan.choices)
     for c in plan.choices:

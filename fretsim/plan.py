@@ -10,7 +10,7 @@ from __future__ import annotations
 import math
 import os
 from dataclasses import dataclass, field
-from typing import Any, Optional
+from typing import Any, Callable, Optional
 
 import numpy as np
 
@@ -122,6 +122,14 @@ def _full_corrections(case: Case, dimension: str):
     return tuple(dict.fromkeys(given + ("free_faces",) + bending))
 
 
+announce: Optional[Callable[[str], None]] = None  # told before each of auto's proxy runs (the CLI prints it)
+
+
+def _announce(what: str) -> None:
+    if announce is not None:
+        announce(what)
+
+
 def _dimension_proxy(case: Case, e_star: float) -> tuple[float, str]:
     from fretsim.simulate import simulate, summarize
     g = case.geometry
@@ -138,6 +146,8 @@ def _dimension_proxy(case: Case, e_star: float) -> tuple[float, str]:
                                   coarse_element=None, linear_jump=None, scheme="bdf2", preset=None,
                                   step_tolerance=max(case.step_tolerance, 0.03))
         setup, _, _ = prepare(proxy)
+        _announce(f"model.dimension auto: a {dim.upper()} proxy run ({' × '.join(map(str, elements))} elements, "
+                  f"{case.cycles} cycles) to compare 2D with 3D")
         out.append(summarize(setup, simulate(setup), 0, 0.0))
     diffs = {key: abs(out[1][key] / out[0][key] - 1) if out[0][key] else 0.0 for key in keys}
     worst = max(diffs, key=diffs.get)
@@ -255,6 +265,10 @@ def choose_corrections(case: Case, grid: Grid, e_star: float, scar_half_width: f
 def _proxy_difference(case: Case, corrections: tuple, dimension: str = "2d") -> tuple[float, str]:
     """Largest relative difference of the reported quantities between proxy runs without and with
     ``corrections``: 2D at the automatic grid, or 3D at half its x resolution."""
+    return _run_proxies(case, corrections, dimension)
+
+
+def _run_proxies(case: Case, corrections: tuple, dimension: str) -> tuple[float, str]:
     from fretsim.simulate import simulate, summarize
     keys = (("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "scar_width_moving_mm",
              "scar_width_stationary_mm") if case.cycles else ("max_pressure_MPa",))
@@ -274,6 +288,8 @@ def _proxy_difference(case: Case, corrections: tuple, dimension: str = "2d") -> 
                                   step_tolerance=max(case.step_tolerance, 0.03) if dimension == "3d"
                                   else case.step_tolerance, **grid)
         setup, _, _ = prepare(proxy)
+        _announce(f"model.corrections auto: a {dimension.upper()} proxy run {'with ' + ', '.join(corr) if corr else 'without corrections'}"
+                  f" ({setup.grid.shape[1]} × {setup.grid.shape[0]} elements, {case.cycles} cycles)")
         last = simulate(setup)
         out.append(summarize(setup, last, 0, 0.0))
     diffs = {k: abs(out[1][k] / out[0][k] - 1) if out[0][k] else 0.0 for k in keys}

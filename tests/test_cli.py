@@ -166,3 +166,11 @@ def test_init_help_lists_the_shipped_cases_and_templates_and_completion_offers_t
     assert "mccoll_185N" in r.output and "ball_partial_slip" in r.output and "roller_on_flat" in r.output
     from fretsim.cli import _complete_kind
     assert "mccoll_1670N" in _complete_kind(None, None, "mccoll_1") and _complete_kind(None, None, "zz") == []
+
+
+def test_autos_proxy_runs_are_announced_and_the_estimate_counts_them():
+    """With `auto`, the proxies ran silently (49 s for the tube at 10⁸ cycles) while `check` estimated 0.23 s."""
+    r = CliRunner().invoke(main, ["check", str(CASES / "tube_RT.yaml"), "--set", "model.dimension=auto"])
+    assert r.exit_code == 0, r.output
+    assert "model.dimension auto: a 3D proxy run" in r.output and "s of planning" in r.output
+    assert "jumping.tolerance 0.01" in r.output
