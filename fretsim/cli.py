@@ -156,6 +156,7 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
     except OSError as exc:  # before any step: the output's place cannot be written
         raise Fail(f"cannot write {output}: {exc.strerror or exc}") from None
     finally:
+        plan_module.announce = None
         progress.stop()
         try:
             signal.signal(signal.SIGTERM, previous_handler)
@@ -282,7 +283,10 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
 
     started = time.perf_counter()
     plan_module.announce = lambda what: click.echo(f"[{time.perf_counter() - started:5.1f} s] {what}", err=True)
-    setup, filled, plan = check_case(load_case(case_file, list(overrides)))
+    try:
+        setup, filled, plan = check_case(load_case(case_file, list(overrides)))
+    finally:
+        plan_module.announce = None
     planning = time.perf_counter() - started
     g = setup.grid
     cells = f"{g.shape[1]} elements of {g.dx * 1e3:.4g} µm" if g.plane_strain else \
