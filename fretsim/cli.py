@@ -446,7 +446,7 @@ def _write_and_list(write, what: str) -> None:
 
 
 @main.command()
-@click.argument("results_files", nargs=-1, required=True, type=click.Path(path_type=Path))
+@click.argument("results_file", type=click.Path(path_type=Path))
 @click.option("--csv", "csv_dir", required=True, type=click.Path(file_okay=False, path_type=Path),
               help="Directory for history.csv, summary.csv, inputs.csv and fields.csv.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")

@@ -176,29 +176,6 @@ def plot_all(res: Results, outdir: str | Path, fmt: str = "png", dpi: int = 150,
 EXPECTED_MARKERS = {"experiment": "o", "fea": "s", "paper": "^"}
 
 
-def _expected_depths(res: Results) -> dict:
-    """source → (centre depth of the flat µm, its scar width mm) from the case's `expected:` data (None: absent)."""
-    from fretsim.case import parse_case
-    from fretsim.units import UnitError, parse_quantity
-    try:
-        expected = parse_case(res.case_yaml).expected or {}
-    except Exception:  # noqa: BLE001 - a file whose case no longer parses simply has nothing to compare with
-        return {}
-    out = {}
-    for source, values in expected.items():
-        if not isinstance(values, dict):
-            continue
-        got = []
-        for key in ("centre_wear_depth_stationary", "scar_width_stationary"):
-            try:
-                got.append(parse_quantity(values[key], "length") if key in values else None)
-            except UnitError:
-                got.append(None)
-        if any(v is not None for v in got):
-            out[source] = (got[0] * 1e3 if got[0] is not None else None, got[1])
-    return out
-
-
 def overlay(results: list, expected: bool = False):
     """Several runs on one figure, as the paper compares RT with 90 °C and runs with and without jumping: the
     final worn profiles of both bodies across the contact, and each body's maximum depth against cycles; with
@@ -217,7 +194,7 @@ def overlay(results: list, expected: bool = False):
         name = res.attrs.get("case_name", "")
         if expected and name not in shown:
             shown.add(name)
-            for source, (depth, width) in _expected_depths(res).items():
+            for source, (depth, width) in res.published().items():
                 m = EXPECTED_MARKERS.get(source, "x")
                 text = f"{source}, {name}: " + ", ".join(
                     t for t in (f"{depth:.3g} µm deep" if depth is not None else "",
@@ -261,6 +238,40 @@ def plot_overlay(results: list, outdir: str | Path, expected: bool = False, fmt:
         if tmp.exists():
             tmp.unlink()
     return [path]
+
+
+def published_profiles(panels: list, path: str | Path) -> Path:
+    """A panel per case: a worn flat across the contact and its published depth and width as markers.
+    ``panels``: (title, x mm, depth µm, {source: (depth µm, width mm)}).  For the validation report."""
+    path = Path(path)
+    cols = min(4, len(panels))
+    rows = -(-len(panels) // cols)
+    fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3.2 * rows), squeeze=False)
+    for ax, (title, x, depth, published) in zip(axes.ravel(), panels):
+        ax.plot(x, [-v for v in depth], "C0-", label="fretsim")
+        for source, (d, w) in published.items():
+            m = EXPECTED_MARKERS.get(source, "x")
+            if d is not None:
+                ax.plot([0.0], [-d], m, color="k", mfc="none", label=source)
+            if w is not None:
+                ax.plot([-w / 2, w / 2], [0.0, 0.0], m, color="k", mfc="none", label=None if d is not None else source)
+        ax.set_title(title, fontsize=9)
+        ax.set_xlabel("x (mm)", fontsize=8)
+        ax.set_ylabel("−depth (µm)", fontsize=8)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=6)
+    for ax in axes.ravel()[len(panels):]:
+        ax.set_visible(False)
+    fig.tight_layout()
+    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
+    try:
+        fig.savefig(tmp, dpi=110, format="png")
+        os.replace(tmp, path)
+    finally:
+        plt.close(fig)
+        if tmp.exists():
+            tmp.unlink()
+    return path
 
 
 def _profiles(res: Results):

@@ -583,6 +583,29 @@ class Results:
     def status(self) -> str:
         return self.attrs.get("status", "")
 
+    def published(self) -> dict:
+        """source (experiment, fea, paper) → (the flat's centre-line depth µm, its scar width mm) from the case's
+        `expected:` data (None where absent): what figures compare with."""
+        from fretsim.units import UnitError, parse_quantity
+        from fretsim.yamlread import YamlProblem, loads
+        try:
+            expected = (loads(self.case_yaml) or {}).get("expected") or {}
+        except (YamlProblem, AttributeError):
+            return {}
+        out = {}
+        for source, values in expected.items() if isinstance(expected, dict) else ():
+            if not isinstance(values, dict):
+                continue
+            got = []
+            for key in ("centre_wear_depth_stationary", "scar_width_stationary"):
+                try:
+                    got.append(parse_quantity(values[key], "length") if key in values else None)
+                except UnitError:
+                    got.append(None)
+            if any(v is not None for v in got):
+                out[source] = (got[0] * 1e3 if got[0] is not None else None, got[1])
+        return out
+
     def to_xarray(self):
         """The run as one xarray Dataset: the fields over (cycle, y, x) at the recorded states, the history over
         ``step`` (every accepted step, with its cycle as the coordinate ``step_cycle``), units on every variable,

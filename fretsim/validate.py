@@ -295,39 +295,15 @@ def _profiles_figure(names: list[str], cases: dict, results: dict, path: Path) -
     drawn = [n for n in names if results[n].get("profile_stationary_um")]
     if not drawn:
         return False
-    import matplotlib
-    matplotlib.use("Agg")
-    import matplotlib.pyplot as plt
-    cols = min(4, len(drawn))
-    rows = -(-len(drawn) // cols)
-    fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3.2 * rows), squeeze=False)
-    for ax, n in zip(axes.ravel(), drawn):
-        res, ev = results[n], cases[n][1].values
-        ax.plot(res["profile_x_mm"], [-v for v in res["profile_stationary_um"]], "C0-", label="fretsim")
-        for group, marker in (("experiment", "o"), ("fea", "s"), ("paper", "^")):
-            depth = ev.get(group, {}).get("centre_wear_depth_stationary")
-            width = ev.get(group, {}).get("scar_width_stationary")
-            if depth is not None:
-                ax.plot([0.0], [-depth], marker, color="k", mfc="none", label=group)
-            if width is not None:
-                ax.plot([-width / 2, width / 2], [0.0, 0.0], marker, color="k", mfc="none",
-                        label=None if depth is not None else group)
-        ax.set_title(f"{n} ({res.get('dimension', '?')})", fontsize=9)
-        ax.set_xlabel("x (mm)", fontsize=8)
-        ax.set_ylabel("−depth (µm)", fontsize=8)
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=6)
-    for ax in axes.ravel()[len(drawn):]:
-        ax.set_visible(False)
-    fig.tight_layout()
-    tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
-    try:
-        fig.savefig(tmp, dpi=110, format="png")
-        os.replace(tmp, path)
-    finally:
-        plt.close(fig)
-        if tmp.exists():
-            tmp.unlink()
+    from fretsim.plotting import published_profiles
+    panels = []
+    for n in drawn:
+        ev = cases[n][1].values
+        published = {g: (ev.get(g, {}).get("centre_wear_depth_stationary"), ev.get(g, {}).get("scar_width_stationary"))
+                     for g in ("experiment", "fea", "paper") if g in ev}
+        panels.append((f"{n} ({results[n].get('dimension', '?')})", results[n]["profile_x_mm"],
+                       results[n]["profile_stationary_um"], published))
+    published_profiles(panels, path)
     return True
 
 

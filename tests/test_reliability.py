@@ -235,12 +235,13 @@ def test_a_huge_case_file_is_refused_before_reading_it(tmp_path):
 
 @pytest.mark.parametrize("overrides", [
     ["model.dimension=2d", "loading.stroke=1 nm"], ["model.dimension=2d", "loading.stroke=10 nm"],
-    ["model.dimension=2d", "loading.normal_load=185 kN"], ["model.dimension=2d", "loading.normal_load=10 MN"],
+    ["model.dimension=2d", "loading.normal_load=185 kN"], ["model.dimension=2d", "loading.normal_load=1 MN"],
     ["geometry.radius=1 um", "geometry.length=10 um", "loading.normal_load=1 mN", "loading.stroke=5 nm"],
-], ids=["1nm", "10nm", "185kN", "10MN", "1um-radius-3d"])
+], ids=["1nm", "10nm", "185kN", "1MN", "1um-radius-3d"])
 def test_valid_extreme_cases_run_instead_of_being_called_too_coarse(overrides):
     out = run(load_case(CASE, [*overrides, "loading.cycles=100"]))
-    assert out.status in ("complete", "stopped"), out.message  # a 10 MN flat wears through: a physical limit
+    assert out.status in ("complete", "stopped"), out.message  # a 1 MN flat wears through: a physical limit
+    # (10 MN is refused before the run now: its unworn contact alone is wider than half the radius)
     assert out.summary["archard_volume_error"] < 1e-9
 
 
