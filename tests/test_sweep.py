@@ -26,6 +26,12 @@ axes:
 """
 
 
+# single-cycle steps: each point takes seconds, so a signal lands inside the points
+SLOW_POINTS = SMALL.replace('"output.snapshots=[400]"', '"output.snapshots=[3000]", jumping.scheme=linear, '
+                                                        'jumping.linear=1').replace("loading.cycles=400",
+                                                                                   "loading.cycles=3000")
+
+
 def sweep_file(tmp_path, text=SMALL, name="s.yaml"):
     path = tmp_path / name
     path.write_text(text)
@@ -226,9 +232,7 @@ def test_a_signalled_sweep_takes_its_workers_with_it(tmp_path, sig):
     workers used to live on (PPID 1, >100 MB each) holding the caller's stdout, and SIGTERM wrote no table.  Now
     the workers die with it, the caller's pipe closes, and SIGTERM ends the sweep as Ctrl-C does (exit 130, the
     table written, the running points interrupted)."""
-    text = SMALL.replace('"output.snapshots=[400]"', '"output.snapshots=[3000]", jumping.scheme=linear, '
-                                                     'jumping.linear=1').replace("loading.cycles=400",
-                                                                                "loading.cycles=3000")
+    text = SLOW_POINTS
     path = sweep_file(tmp_path, text)
     out = tmp_path / "o"
     proc = subprocess.Popen([sys.executable, "-m", "fretsim", "sweep", str(path), "-o", str(out), "--jobs", "2"],
@@ -290,9 +294,7 @@ def test_the_api_sweep_returns_the_table_the_cli_writes(tmp_path):
 
 def test_ctrl_c_stops_a_sweep_at_once_with_its_points_interrupted_and_a_rerun_completes_them(tmp_path):
     # single-cycle steps: each point takes seconds, so the interrupt lands inside the points
-    text = SMALL.replace('"output.snapshots=[400]"', '"output.snapshots=[3000]", jumping.scheme=linear, '
-                                                     'jumping.linear=1').replace("loading.cycles=400",
-                                                                                "loading.cycles=3000")
+    text = SLOW_POINTS
     path = sweep_file(tmp_path, text)
     out = tmp_path / "stopped"
     proc = subprocess.Popen([sys.executable, "-m", "fretsim", "sweep", str(path), "-o", str(out), "--jobs", "2"],
