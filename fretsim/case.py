@@ -30,6 +30,8 @@ PRESETS = {"paper": {"scheme": "adaptive", "eta": 0.55, "max": 600, "linear": 55
 DIMENSIONS = ("2d", "3d", "auto")
 GAP_MODELS = ("auto", "mid_stroke", "stroke_average")
 SLIP_MODELS = ("auto", "uniform", "coulomb")
+GRID_RULES = ("accuracy", "paper")
+GRID_ERRORS = ("companion", "none")
 STROKE_MODELS = ("auto", "mid_stroke", "resolved")
 WEAR_LAWS = ("archard", "energy")
 CORRECTIONS = ("ring_bending", "free_faces")
@@ -179,7 +181,14 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "domain": Key("lengths", "[x, y] extents (one entry in 2D); automatic from the final scar if absent", None),
         "elements": Key("counts", "[Mx, My] elements; automatic (7a/40) if absent", None, lo=1, hi=100_000),
         "coarse_element": Key("lengths", "[dx, dy] of a coarse grid to solve the contact on (refinement, "
-                                         "Eqs. 11–12)", None)},
+                                         "Eqs. 11–12)", None),
+        "rule": Key("choice", "how the automatic grid is sized: accuracy (the element along x small enough for "
+                              "the scar widths to meet model.accuracy, never coarser than the paper's) or paper "
+                              "(the paper's convergence rule, dx = 7a/40)", "accuracy", choices=GRID_RULES),
+        "error_estimate": Key("choice", "the grid's part of the reported error estimates: companion (a second "
+                                        "run on a grid twice as coarse; it adds about a third to the run's "
+                                        "time) or none (the estimates then cover the stepping only, and say so)",
+                              "companion", choices=GRID_ERRORS)},
     "output": {
         "snapshots": Key("cycle_list", "cycles at which fields are written (+ the last); auto: 0, N/4, N/2, "
                                        "3N/4, N", None)},
@@ -241,6 +250,8 @@ class Case:
     max_jump: Optional[int] = None
     preset: Optional[str] = None
     coarse_element: Optional[tuple[float, ...]] = None  # mm
+    grid_rule: str = "accuracy"
+    grid_error: str = "companion"
     domain: Optional[tuple[float, ...]] = None  # mm
     elements: Optional[tuple[int, ...]] = None
     snapshots: Optional[tuple[int, ...]] = None
@@ -302,6 +313,7 @@ class Case:
             grid["elements"] = list(self.elements)
         if self.coarse_element is not None:
             grid["coarse_element"] = [format_quantity(d, "length") for d in self.coarse_element]
+        grid["rule"], grid["error_estimate"] = self.grid_rule, self.grid_error
         loading = {"normal_load": format_quantity(self.normal_load, "force"),
                    "stroke": format_quantity(self.stroke, "length"), "cycles": self.cycles}
         if self.friction_coefficient is not None:
@@ -758,5 +770,6 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
                 tolerance=solver["tolerance"], scheme=scheme, step_tolerance=jumping["tolerance"],
                 linear_jump=jumping.get("linear") if scheme in ("linear", "adaptive") else jumping.get("linear"),
                 eta=jumping["eta"], max_jump=jumping.get("max"), preset=preset, coarse_element=coarse,
+                grid_rule=grid["rule"], grid_error=grid["error_estimate"],
                 domain=domain, elements=elements, snapshots=output.get("snapshots"), expected=expected,
                 overrides=overrides, source=source)

@@ -170,6 +170,9 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
     if outcome.status != "complete":
         raise Fail(f"run failed: {outcome.message}" + (f"; steps up to the failure are in {output} (status 'failed')"
                                                        if outcome.written else ""), EXIT_FAILED)
+    if not quiet:
+        for note in outcome.notes[len(outcome.setup.notes):]:
+            click.echo(f"note: {note}", err=True)
     click.echo(_paragraph(outcome))
 
 
@@ -237,6 +240,18 @@ def _regime(s: dict, c) -> str:
             f"dissipated per cycle.")
 
 
+def _estimates(s: dict) -> str:
+    """The error sentence: the totals (stepping, grid and accepted model difference) and the stepping's part."""
+    import math
+    stepping = (f"the stepping's part at the recorded states: depth {s['error_estimate_depth']:.1e}, pressure "
+                f"{s['error_estimate_pressure']:.1e}")
+    if math.isnan(s.get("estimated_error_depth", float("nan"))):
+        return f"Estimated error (relative): the grid's part not estimated; {stepping}."
+    return (f"Estimated error (relative; stepping, grid and model): depth {s['estimated_error_depth']:.1e}, scar "
+            f"width {s['estimated_error_width']:.1e}, pressure field {s['estimated_error_pressure']:.1e}, its peak "
+            f"{s['estimated_error_max_pressure']:.1e} ({stepping}).")
+
+
 def _paragraph(outcome) -> str:
     s, c, g = outcome.summary, outcome.case, outcome.setup.grid
     cells = f"{g.shape[1]} elements" if g.plane_strain else f"{g.shape[1]} × {g.shape[0]} elements"
@@ -260,9 +275,8 @@ def _paragraph(outcome) -> str:
                  f" volume {s['wear_volume_stationary_mm3']:.4g} mm³. Moving body: centre-line "
                  f"{s['centre_wear_depth_moving_um']:.3g} µm (max {s['max_wear_depth_moving_um']:.3g} µm), volume "
                  f"{s['wear_volume_moving_mm3']:.4g} mm³. Volume against its invariant "
-                 f"({outcome.setup.cycle.invariant}): {s['archard_volume_error']:.1e}; "
-                 f"estimated error at the recorded states: depth {s['error_estimate_depth']:.1e}, pressure "
-                 f"{s['error_estimate_pressure']:.1e} (relative).")
+                 f"({outcome.setup.cycle.invariant}): {s['archard_volume_error']:.1e}. "
+                 f"{_estimates(s)}")
     else:
         text += f" Contact only: peak pressure {s['max_pressure_MPa']:.4g} MPa."
     return text + f" Results: {outcome.output}"

@@ -8,6 +8,8 @@ returns the matplotlib figures (tests check what is drawn), :func:`plot_all` sav
 """
 from __future__ import annotations
 
+import math
+
 import os
 import threading
 from pathlib import Path
@@ -62,6 +64,11 @@ def title_block(res: Results) -> str:
                      f"{_input(res, 'gap_model', '')}, {_input(res, 'scheme', '')}")
     if res.overrides:
         parts.append("--set " + " ".join(res.overrides))
+    est = [(label, res.summary.get(f"estimated_error_{key}")) for label, key in
+           (("depth", "depth"), ("width", "width"), ("pressure", "pressure"), ("peak pressure", "max_pressure"))]
+    if all(isinstance(v, float) and math.isfinite(v) for _, v in est):
+        parts.append("estimated error (stepping + grid + model): "
+                     + ", ".join(f"{label} ±{v:.1%}" for label, v in est))
     return "\n".join(parts)
 
 

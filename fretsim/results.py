@@ -86,8 +86,10 @@ HISTORY = {
     "checkerboard_amplitude": ("1", "odd-even pressure amplitude relative to the mean", lambda s: abs(s.checkerboard)),
     "cycle_jump": ("cycles", "cycles since the previous step", lambda s: s.jump),
     "rejected_steps": ("1", "steps rejected since the previous accepted one", lambda s: s.rejected),
-    "error_estimate_depth": ("1", "estimated relative error of the maximum depths", lambda s: s.error_depth),
-    "error_estimate_pressure": ("1", "estimated relative error of the pressure field", lambda s: s.error_pressure),
+    "error_estimate_depth": ("1", "the stepping's part of the relative error of the maximum depths (the run's "
+                                  "estimate against the exact per-cycle model on its grid)", lambda s: s.error_depth),
+    "error_estimate_pressure": ("1", "the stepping's part of the relative error of the pressure field (L2)",
+                                lambda s: s.error_pressure),
     "dissipated_energy_J": ("J", "energy dissipated per cycle by friction at this state (NaN: no friction "
                                  "coefficient)", lambda s: s.cycle_result.energy * 1e-3),
     "wear_work": ("N*mm", "the wear invariant's work accumulated: Σp·|ds|·A (Archard) or Σ|q|·|ds|·A (energy "
@@ -122,10 +124,14 @@ SUMMARY_UNITS = {
     "element_size_x_um": "um", "element_size_y_um": "um", "elements_x": "1", "elements_y": "1",
     "error_estimate_depth": "1", "error_estimate_pressure": "1", "regime": "", "tangential_force_amplitude_N": "N",
     "dissipated_energy_per_cycle_J": "J", "stick_half_width_x_mm": "mm", "gross_slip_stroke_um": "um",
+    "estimated_error_depth": "1", "estimated_error_width": "1", "estimated_error_pressure": "1",
+    "estimated_error_max_pressure": "1",
 }
 # NaN in 2D; infinite when nothing wears; unknown without a friction coefficient
 NAN_SUMMARY = {"element_size_y_um", "stability_limit_linear", "tangential_force_amplitude_N",
-               "dissipated_energy_per_cycle_J", "gross_slip_stroke_um"}
+               "dissipated_energy_per_cycle_J", "gross_slip_stroke_um", "estimated_error_depth", "estimated_error_width",
+               "estimated_error_pressure", "estimated_error_max_pressure"}  # not estimated: grid.error_estimate none,
+#                                                                            or a run that did not complete
 
 
 class ResultsIOError(OSError):

@@ -13,6 +13,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from fretsim import grid_error
 from fretsim.case import GEOMETRY_KEYS, Case, CaseError, parse_case
 from fretsim.plan import Plan, prepare
 from fretsim.reference import effective_modulus
@@ -41,6 +42,8 @@ class _Counter:
     """Counts solves and keeps the last step and the largest error estimates at recorded states."""
 
     def __init__(self, solves: int = 0, errors: tuple = (0.0, 0.0)):
+        self.extra = None  # the total error estimates, once the run is complete
+        self.notes = []  # what the estimates found, for the results file and the outcome
         self.solves = solves
         self.last = None
         self.errors = tuple(errors)
@@ -236,6 +239,19 @@ def _execute(setup, filled, plan, output, overwrite, progress, observers, resume
         finally:
             _restore_signals(previous)
         raise
+    if status == "complete" and counter.last is not None:
+        try:
+            counter.extra = _error_estimates(setup, filled, plan, counter)
+        except KeyboardInterrupt:
+            previous = _ignore_signals()
+            try:
+                _finish(writer, setup, counter, t0, "interrupted", "interrupted while estimating the grid's error "
+                        f"(the run itself is complete); resume with `fretsim run --resume {output}`")
+            except ResultsIOError:
+                pass
+            finally:
+                _restore_signals(previous)
+            raise
     previous = _ignore_signals()  # a Ctrl-C in the last instant must not make a complete run look interrupted
     try:
         _finish(writer, setup, counter, t0, status, message)
@@ -248,7 +264,7 @@ def _execute(setup, filled, plan, output, overwrite, progress, observers, resume
     finally:
         _restore_signals(previous)
     return Outcome(status, message, _summary(setup, counter, t0), setup, filled, Path(output) if output else None,
-                   counter.last, setup.notes, plan, writer is not None)
+                   counter.last, tuple(setup.notes) + tuple(counter.notes), plan, writer is not None)
 
 
 def _ignore_signals() -> dict:
@@ -283,7 +299,44 @@ def _recorded_errors(previous: Results) -> tuple:
 
 
 def _summary(setup, counter, t0) -> dict:
-    return summarize(setup, counter.last, counter.solves, _elapsed(counter, t0), counter.errors) if counter.last else {}
+    if counter.last is None:
+        return {}
+    out = summarize(setup, counter.last, counter.solves, _elapsed(counter, t0), counter.errors)
+    out.update(counter.extra or {k: float("nan") for k in grid_error.KEYS})
+    return out
+
+
+def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter") -> dict:
+    """The total error estimates of the reported numbers: the stepping's, the grid's (from a companion run on a
+    grid twice as coarse, see :mod:`fretsim.grid_error`) and the model difference ``auto`` accepted."""
+    from fretsim.plan import _announce, prepare as prepare_case
+    summary = summarize(setup, counter.last, counter.solves, 0.0, counter.errors)
+    model_part = sum(c.error for c in plan.choices)
+    if filled.grid_error == "none" or filled.cycles == 0 or filled.elements is None:
+        return grid_error.totals(summary, None, model_part)
+    companion = grid_error.companion_case(filled, setup.y_edges_free and not setup.grid.plane_strain)
+    try:
+        c_setup, _, _ = prepare_case(companion)
+        _announce(f"grid error: the case again on a grid twice as coarse ({c_setup.grid.shape[1]} × "
+                  f"{c_setup.grid.shape[0]} elements) to estimate the grid's part of the error")
+        last = simulate(c_setup)
+    except (SimulationError, CaseError) as exc:  # e.g. the mid-stroke gap, stable on the run's grid, is not on
+        #                                           the coarser one: the run stands, its grid error is unknown
+        counter.notes.append(f"the grid's error was not estimated: its companion run on a grid twice as coarse "
+                             f"stopped ({str(exc)[:160]})")
+        return grid_error.totals(summary, None, model_part)
+    coarse = summarize(c_setup, last, 0, 0.0)
+    part = grid_error.grid_estimates(summary, coarse, counter.last.pressure, setup.grid, last.pressure,
+                                     c_setup.grid)
+    out = grid_error.totals(summary, part, model_part)
+    over = [f"{what} {out[key]:.2%}" for key, what in (("estimated_error_depth", "the depths"),
+                                                        ("estimated_error_width", "the scar widths"))
+            if out[key] > filled.accuracy]
+    if over:
+        counter.notes.append(f"the estimated error of {' and of '.join(over)} exceeds model.accuracy "
+                             f"({filled.accuracy:.2%}); a finer grid.elements (the companion grid's difference is "
+                             f"most of it) or a smaller jumping.tolerance brings it down")
+    return out
 
 
 def _elapsed(counter, t0) -> float:
@@ -292,4 +345,5 @@ def _elapsed(counter, t0) -> float:
 
 def _finish(writer, setup, counter, t0, status, message):
     if writer is not None:
+        writer.notes = tuple(dict.fromkeys(writer.notes + tuple(counter.notes)))
         writer.finish(status, message, _summary(setup, counter, t0))

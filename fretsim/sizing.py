@@ -14,10 +14,18 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import Optional
 
 from fretsim.geometry import Geometry
 
 ELEMENTS_OVER_7A = 40  # paper Table 1
+# The reported scar widths are where the depth crosses 0.1 % of its peak.  Between element centres that crossing
+# is known to about half an element at each edge (scripts/study_grid_error.py: the widths' error at the paper's
+# grid is 1-2 %, about one element, and not monotone in the element size), so a width within model.accuracy
+# needs an element of at most accuracy/WIDTH_SHARE of the scar: a third of the accuracy for the element, the rest
+# for what the coarser companion grid sees (fretsim.grid_error).
+WIDTH_SHARE = 3.0
+MAX_ACCURACY_REFINEMENT = 4.0  # per axis, over the paper's rule: beyond it the cost grows faster than it pays
 LINE_ROWS = 27  # paper section 2.1.1: 370 µm across a 10 mm cylinder
 SCAR_MARGIN = 1.3
 
@@ -30,6 +38,8 @@ class Sizing:
     domain: tuple[float, ...]  # mm
     elements: tuple[int, ...]
     note: str
+    rule: str = "the paper's convergence rule, dx = 7a/40"  # which rule sized the element along x, and why ("": the
+    #                                                          partial-slip refinement, said by the plan)
 
 
 def _odd(n: float) -> int:
@@ -38,10 +48,11 @@ def _odd(n: float) -> int:
 
 
 def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float, cycles: int, k_total: float,
-              e_star: float, strokes: int = 1, refine: float = 1.0) -> Sizing:
+              e_star: float, strokes: int = 1, refine: float = 1.0, accuracy: Optional[float] = None) -> Sizing:
     """The paper's element size and a domain holding the estimated final scar (both bodies' volume), plus
     ``strokes`` stroke amplitudes along x (the flat's wear reaches one stroke beyond the contact; seen through
-    the stroke average, two)."""
+    the stroke average, two).  Given ``accuracy``, the element along x is also at most accuracy/WIDTH_SHARE of
+    the estimated scar width (at most MAX_ACCURACY_REFINEMENT times finer than the paper's)."""
     h = geometry.hertz(load, e_star)
     a = h.half_width_x
     volume = k_total * load * 4 * stroke * cycles
@@ -49,14 +60,34 @@ def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float
     # no contact is wider than the body: beyond that the run stops at the physical limit
     limits = geometry.limits
     scar_x = min(scar_x, 2 * limits.reach_x)
-    dx = 7 * a / ELEMENTS_OVER_7A / refine
+    paper = 7 * a / ELEMENTS_OVER_7A
+    dx = paper / refine
+    rule = "7a/40" if refine == 1.0 else f"7a/40 ÷ {refine:.3g}"
+    why = ("" if refine != 1.0 else "the paper's convergence rule, dx = 7a/40" if accuracy is None else
+           f"grid.rule accuracy: the paper's convergence rule, dx = 7a/40, already under a third of model.accuracy "
+           f"({accuracy:.2g}) of the estimated scar width")
+    if accuracy is not None and cycles > 0:
+        width = 2 * max(scar_x, a)
+        for_width = max(accuracy * width / WIDTH_SHARE, paper / MAX_ACCURACY_REFINEMENT)
+        if for_width < dx:
+            dx = for_width
+            capped = for_width == paper / MAX_ACCURACY_REFINEMENT
+            rule = (f"7a/40 ÷ {MAX_ACCURACY_REFINEMENT:g}" if capped else
+                    f"{accuracy:.2g} × the scar width {width:.3g} mm / {WIDTH_SHARE:g}")
+            why = (f"grid.rule accuracy: the element along x a third of model.accuracy ({accuracy:.2g}) of the "
+                   f"estimated scar width {width:.3g} mm (a width is known to about an element), finer than the "
+                   f"paper's 7a/40 = {paper * 1e3:.3g} µm"
+                   + (f", capped at {MAX_ACCURACY_REFINEMENT:g}× finer (the widths would need "
+                      f"{accuracy * width / WIDTH_SHARE * 1e3:.3g} µm; the companion grid's estimate says how far "
+                      f"they are)" if capped else ""))
+    if refine != 1.0 and why:
+        why += f"; along y the paper's rule refined ÷ {refine:.3g} for partial slip"
     reach = SCAR_MARGIN * max(scar_x, a) + strokes * stroke + 3 * dx
     nx = _odd(2 * reach / dx)
-    rule = "7a/40" if refine == 1.0 else f"7a/40 ÷ {refine:.3g}"
     note = (f"dx = {rule} = {dx * 1e3:.3g} µm (a = {a * 1e3:.3g} µm), x extent {nx * dx:.3g} mm for an estimated "
             f"scar half-width {scar_x:.3g} mm")
     if plane_strain:
-        return Sizing(a, h.half_width_y, scar_x, (nx * dx,), (nx,), note)
+        return Sizing(a, h.half_width_y, scar_x, (nx * dx,), (nx,), note, why)
     if h.line:
         ny, ly = LINE_ROWS, geometry.line_length
     else:
@@ -65,4 +96,4 @@ def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float
         ny = _odd(2 * (SCAR_MARGIN * max(scar_y, h.half_width_y) + 3 * dy) / dy)
         ly = ny * dy
     return Sizing(a, h.half_width_y, scar_x, (nx * dx, ly), (nx, ny),
-                  note + f"; dy = {ly / ny * 1e3:.3g} µm, y extent {ly:.3g} mm")
+                  note + f"; dy = {ly / ny * 1e3:.3g} µm, y extent {ly:.3g} mm", why)

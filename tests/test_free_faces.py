@@ -123,16 +123,17 @@ def _worst(a: dict, b: dict) -> float:
     return max(abs(a[k] / b[k] - 1) for k in KEYS)
 
 
-@pytest.mark.parametrize("name, picked", [("mccoll_185N", "2d"), ("mccoll_1670N", "3d")])
+@pytest.mark.parametrize("name, picked", [("mccoll_185N", "3d"), ("mccoll_1670N", "3d")])
 def test_autos_pick_is_within_model_accuracy_of_the_full_model_and_the_cheaper_one_is_not(name, picked):
     # the full model of a cylinder on a flat: 3D with the cylinder's free ends.  auto must land within
-    # model.accuracy (1 %) of it; where it picked 3D, the 2D it passed over must be farther than that
-    # (scripts/results/model_hierarchy.txt: 0.63 % for 2D at 185 N; 1.28 % for 2D at 1670 N)
+    # model.accuracy (1 %) of it; where 2D is farther than that it must pick 3D
+    # (scripts/results/model_hierarchy.txt: 0.63 % for 2D at 185 N; 1.28 % for 2D at 1670 N).  At 185 N the
+    # proxy's 0.6 % is within 1 % but not within 1 %/3, the margin a proxy's own uncertainty asks: 3D
     case = CASES / f"{name}.yaml"
     auto = run(load_case(case, ["model.dimension=auto", "model.corrections=auto"]))
     full = run(load_case(case, ["model.dimension=3d", "model.corrections=[free_faces]"])).summary
     assert auto.case.dimension == picked
     assert _worst(auto.summary, full) < 0.01
-    if picked == "3d":
+    if name == "mccoll_1670N":
         assert auto.case.corrections == ("free_faces",)
         assert _worst(run(load_case(case, ["model.dimension=2d"])).summary, full) > 0.01

@@ -307,7 +307,8 @@ def test_the_loops_area_is_the_dissipated_energy():
 # --- whole runs ---------------------------------------------------------------------------------------------------
 
 CASES = __import__("pathlib").Path(__file__).resolve().parents[1] / "cases"
-COULOMB_2D = ["model.dimension=2d", "loading.friction_coefficient=0.9", "model.slip=coulomb"]
+# the paper's grid: these runs compare stepping schemes, the explicit ones among them, on one grid
+COULOMB_2D = ["model.dimension=2d", "loading.friction_coefficient=0.9", "model.slip=coulomb", "grid.rule=paper"]
 
 
 def _run(*overrides, case="mccoll_185N.yaml", output=None):

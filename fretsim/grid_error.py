@@ -1,0 +1,79 @@
+"""The grid's part of the error: the run repeated on a grid twice as coarse, and what the difference says.
+
+The stepping estimates (``error_estimate_*``) say how far a run is from the exact per-cycle model *on its grid*;
+they say nothing of the grid.  Here the finished case is run again, with the same stepping, on the same domain
+with half the elements along x (and along y for a point contact; a line contact keeps the paper's rows).  The
+difference of each reported number between the two grids, read as a Richardson estimate, is the grid's part of
+its error.  How each is read follows what ``scripts/study_grid_error.py`` measured against runs 32× finer
+(Table 4 cases, 2D and 3D):
+
+- depths converge fast (about h²) and smoothly: the difference itself, an over-estimate of about 3×;
+- a scar width is where the depth crosses 0.1 % of its peak; between element centres that crossing is known to
+  about half an element at each edge, and the widths' error is not monotone in the element (500 N / 10 µm at
+  7a/80: 1.0 %, twice its error at 7a/40).  The estimate is the difference plus one element over the width;
+- the pressure field (L2) converges slowly (its steep flanks at the scar's edges): the difference, with the
+  coarse field interpolated to the fine centres, an over-estimate of 2-7× measured;
+- its peak sits on those flanks and does not converge smoothly (measured from −36 % to +8 % over 1-32× finer
+  grids): read as if it fell with √h (the difference × 1/(√2 − 1)), and never below the field's estimate.
+"""
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+import numpy as np
+
+COARSER = 2.0
+SQRT_H = 1.0 / (math.sqrt(2.0) - 1.0)  # Richardson's factor for an error falling as √h, grids 2× apart
+DEPTHS = ("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "centre_wear_depth_moving_um",
+          "centre_wear_depth_stationary_um")
+WIDTHS = ("scar_width_moving_mm", "scar_width_stationary_mm")
+KEYS = ("estimated_error_depth", "estimated_error_width", "estimated_error_pressure", "estimated_error_max_pressure")
+
+
+def _odd(n: float) -> int:
+    n = max(int(round(n)), 3)
+    return n if n % 2 else n + 1
+
+
+def companion_case(filled, line_contact: bool):
+    """The finished case (automatic choices filled) on a grid COARSER times coarser, otherwise unchanged."""
+    e = filled.elements
+    elements = (_odd(e[0] / COARSER),) + (() if len(e) == 1 else (e[1],) if line_contact else (_odd(e[1] / COARSER),))
+    coarse = None if filled.coarse_element is None else tuple(c * COARSER for c in filled.coarse_element)
+    return filled.with_choices(elements=elements, coarse_element=coarse, grid_error="none",
+                               snapshots=(filled.cycles,))
+
+
+def _relative(a: float, b: float) -> float:
+    return abs(a - b) / abs(a) if a else 0.0
+
+
+def _on(field: np.ndarray, x: np.ndarray, y: np.ndarray, xf: np.ndarray, yf: np.ndarray) -> np.ndarray:
+    """A coarse field read at the fine centres (linear along x, then along y; held beyond the last centre)."""
+    along_x = np.stack([np.interp(xf, x, row) for row in np.atleast_2d(field)])
+    if along_x.shape[0] == 1:
+        return np.broadcast_to(along_x, (len(yf), len(xf))) if len(yf) > 1 else along_x
+    return np.stack([np.interp(yf, y, col) for col in along_x.T], axis=1)
+
+
+def grid_estimates(fine: dict, coarse: dict, p_fine: np.ndarray, grid_fine, p_coarse: np.ndarray,
+                   grid_coarse) -> dict:
+    """The grid's part of the relative error of the depths, the widths, the pressure field (L2) and its peak."""
+    depth = max(_relative(fine[k], coarse[k]) for k in DEPTHS)
+    width = max((_relative(fine[k], coarse[k]) + grid_fine.dx / fine[k]) if fine[k] else 0.0 for k in WIDTHS)
+    pc = _on(p_coarse, grid_coarse.x, grid_coarse.y, grid_fine.x, grid_fine.y)
+    norm = float(np.linalg.norm(p_fine))
+    pressure = float(np.linalg.norm(np.atleast_2d(p_fine) - pc)) / norm if norm else 0.0
+    peak = max(SQRT_H * _relative(fine["max_pressure_MPa"], coarse["max_pressure_MPa"]), pressure)
+    return dict(zip(KEYS, (depth, width, pressure, peak)))
+
+
+def totals(summary: dict, grid_part: Optional[dict], model_part: float = 0.0) -> dict:
+    """The reported estimates: the stepping's (``error_estimate_*``), the grid's and the model difference ``auto``
+    accepted, added (each bounds its own part; adding them does not assume they cancel)."""
+    step_depth, step_pressure = summary["error_estimate_depth"], summary["error_estimate_pressure"]
+    stepping = dict(zip(KEYS, (step_depth, step_depth, step_pressure, step_pressure)))
+    if grid_part is None:
+        return {k: float("nan") for k in KEYS}
+    return {k: float(stepping[k] + grid_part[k] + (model_part if k in KEYS[:2] else 0.0)) for k in KEYS}

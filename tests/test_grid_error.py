@@ -1,0 +1,141 @@
+"""The reported error estimates cover the grid: honest against runs on much finer grids, sized to model.accuracy."""
+import functools
+import math
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fretsim.api import load_case, run
+from fretsim.grid_error import companion_case
+from fretsim.sizing import MAX_ACCURACY_REFINEMENT, WIDTH_SHARE
+
+CASES = Path(__file__).resolve().parents[1] / "cases"
+DEPTHS = ("max_wear_depth_moving_um", "max_wear_depth_stationary_um")
+WIDTHS = ("scar_width_moving_mm", "scar_width_stationary_mm")
+
+
+def _on(p, x, xf):
+    return np.stack([np.interp(xf, x, row) for row in np.atleast_2d(p)])
+
+
+def _finer(name, out, factor, extra=()):
+    """The same case on the same domain with ``factor`` times the elements along x, stepping tightened 10×."""
+    f = out.case
+    elements = [int(f.elements[0] * factor) | 1] + list(f.elements[1:])
+    ov = ["model.dimension=2d", f"jumping.tolerance={f.step_tolerance / 10}",
+          f"grid.domain=[{', '.join(f'{d!r} mm' for d in f.domain)}]",
+          f"grid.elements=[{', '.join(map(str, elements))}]", *extra]
+    return run(load_case(CASES / f"{name}.yaml", ov))
+
+
+@functools.lru_cache(maxsize=None)
+def _default_and_reference(name):
+    out = run(load_case(CASES / f"{name}.yaml", ["model.dimension=2d"]))
+    return out, _finer(name, out, 4)
+
+
+@pytest.mark.parametrize("name", ["mccoll_185N", "mccoll_500N_10um", "mccoll_1670N", "kirk_450N_20Hz"])
+def test_default_depths_and_widths_meet_the_accuracy_and_their_estimates_cover_their_errors(name):
+    """Against the same case on a grid 4× finer (and 10× tighter stepping): the depths and widths within
+    model.accuracy (1 %), and each estimate at least the error it estimates.  The reference has errors of its
+    own, about a quarter to a sixteenth of the default's (widths and depths converge as h to h²; the study
+    script's runs 32× finer say the same), which is why the bound is the estimate itself and not a fraction."""
+    out, ref = _default_and_reference(name)
+    s, r = out.summary, ref.summary
+    depth = max(abs(s[k] / r[k] - 1) for k in DEPTHS)
+    width = max(abs(s[k] / r[k] - 1) for k in WIDTHS)
+    assert depth <= out.case.accuracy and width <= out.case.accuracy, (depth, width)
+    assert depth <= s["estimated_error_depth"], (depth, s["estimated_error_depth"])
+    assert width <= s["estimated_error_width"], (width, s["estimated_error_width"])
+    assert s["estimated_error_depth"] >= s["error_estimate_depth"]  # the totals include the stepping's part
+
+
+@pytest.mark.parametrize("name", ["mccoll_185N", "mccoll_500N_10um", pytest.param("mccoll_1670N", marks=pytest.mark.xfail(
+    strict=True, reason="known: the final pressure field is 22 % (L2) from the 4×-finer run's against an estimate "
+                        "of 10 %; the field's contact front moves an element at a time (README: Stepping), and its "
+                        "phase at the last state is not what a grid twice as coarse sees")), "kirk_450N_20Hz"])
+def test_the_pressure_fields_and_peaks_estimates_cover_their_errors(name):
+    out, ref = _default_and_reference(name)
+    s, r = out.summary, ref.summary
+    pr = _on(ref.last.pressure, ref.setup.grid.x, out.setup.grid.x)
+    pressure = float(np.linalg.norm(out.last.pressure - pr) / np.linalg.norm(pr))
+    peak = abs(s["max_pressure_MPa"] / r["max_pressure_MPa"] - 1)
+    assert pressure <= s["estimated_error_pressure"], (pressure, s["estimated_error_pressure"])
+    assert peak <= s["estimated_error_max_pressure"], (peak, s["estimated_error_max_pressure"])
+    assert s["estimated_error_pressure"] >= s["error_estimate_pressure"]
+
+
+def test_the_papers_grid_gets_an_honest_width_estimate_beyond_the_accuracy_and_says_so():
+    """At the paper's 7a/40 the 2D widths are 1-2 % off (the issue's finding): the estimate must see it."""
+    out = run(load_case(CASES / "mccoll_1670N.yaml", ["model.dimension=2d", "grid.rule=paper"]))
+    ref = _finer("mccoll_1670N", out, 8)
+    width = max(abs(out.summary[k] / ref.summary[k] - 1) for k in WIDTHS)
+    assert width > out.case.accuracy  # measured 1.8 %: the paper's grid misses 1 %
+    assert out.summary["estimated_error_width"] >= width
+    assert any("exceeds model.accuracy" in n for n in out.notes)
+
+
+def test_the_accuracy_rule_sizes_the_element_by_the_scar_and_the_paper_rule_by_the_contact():
+    acc = run_check("mccoll_185N", ["model.dimension=2d"])
+    paper = run_check("mccoll_185N", ["model.dimension=2d", "grid.rule=paper"])
+    dx_paper = paper[0].grid.dx
+    hertz_a = dx_paper * 40 / 7
+    assert acc[0].grid.dx < dx_paper / 2 and acc[0].grid.dx >= dx_paper / MAX_ACCURACY_REFINEMENT * (1 - 1e-9)
+    reason = next(c.reason for c in acc[2].choices if c.key == "grid.elements")
+    assert "grid.rule accuracy" in reason and "scar width" in reason
+    assert math.isclose(hertz_a * 7 / 40, dx_paper)
+    loose = run_check("mccoll_185N", ["model.dimension=2d", "model.accuracy=0.2"])
+    assert loose[0].grid.dx == pytest.approx(dx_paper)  # the paper's element is already a fine enough share
+    assert WIDTH_SHARE >= 2  # a width is known to about an element; the rest of the accuracy is the companion's
+
+
+def run_check(name, ov):
+    from fretsim.api import check
+    return check(load_case(CASES / f"{name}.yaml", ov))
+
+
+def test_the_companion_halves_the_elements_along_x_and_keeps_a_line_contacts_rows():
+    line = run_check("mccoll_185N", ["model.dimension=3d"])[1]
+    c = companion_case(line, True)
+    assert c.elements[1] == line.elements[1] and abs(c.elements[0] - line.elements[0] / 2) <= 1.5
+    ball = run_check("wire_rope", [])[1]
+    c = companion_case(ball, False)
+    assert all(abs(a - b / 2) <= 1.5 for a, b in zip(c.elements, ball.elements)) and c.grid_error == "none"
+
+
+def test_without_the_companion_the_totals_are_not_given_and_the_text_says_so(tmp_path):
+    from click.testing import CliRunner
+    from fretsim.cli import main
+    res = CliRunner().invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), "-o", str(tmp_path / "r.h5"), "--set",
+                                    "model.dimension=2d", "--set", "grid.error_estimate=none", "--quiet"])
+    assert res.exit_code == 0, res.output
+    assert "the grid's part not estimated" in res.output
+    from fretsim.results import read_results
+    s = read_results(tmp_path / "r.h5").summary
+    assert math.isnan(s["estimated_error_width"]) and s["error_estimate_depth"] > 0
+
+
+SHIPPED = sorted(p.stem for p in CASES.glob("*.yaml"))
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name", SHIPPED)
+def test_auto_keeps_its_promise_against_the_fullest_model_at_full_resolution(name):
+    """Both keys on auto, against the fullest model (3D with every correction that applies) on the default grid:
+    each reported depth and width within model.accuracy.  auto accepts a simpler model only where three times
+    its proxy's difference is within the accuracy (a proxy at half the x resolution under-stated 2D's difference
+    2.5× on mccoll_500N_10um), and the reported depth and width estimates carry that product."""
+    from fretsim.plan import available_corrections
+    case = load_case(CASES / f"{name}.yaml", ["model.dimension=auto", "model.corrections=auto"])
+    chosen = run(case)
+    full_case = load_case(CASES / f"{name}.yaml", ["model.dimension=3d"])
+    fullest = available_corrections(full_case, False)
+    full = run(load_case(CASES / f"{name}.yaml", ["model.dimension=3d", "model.corrections="
+                                                  + (f"[{', '.join(fullest)}]" if fullest else "none")]))
+    if not chosen.summary["cycles"]:
+        keys = ("max_pressure_MPa",)
+    else:
+        keys = DEPTHS + WIDTHS + ("centre_wear_depth_stationary_um",)
+    diff = max(abs(chosen.summary[k] / full.summary[k] - 1) for k in keys if full.summary[k])
+    assert diff <= case.accuracy, (diff, chosen.case.dimension, chosen.case.corrections)
