@@ -52,8 +52,8 @@ def _relative(a: float, b: float) -> float:
 def _on(field: np.ndarray, x: np.ndarray, y: np.ndarray, xf: np.ndarray, yf: np.ndarray) -> np.ndarray:
     """A coarse field read at the fine centres (linear along x, then along y; held beyond the last centre)."""
     along_x = np.stack([np.interp(xf, x, row) for row in np.atleast_2d(field)])
-    if along_x.shape[0] == 1:
-        return np.broadcast_to(along_x, (len(yf), len(xf))) if len(yf) > 1 else along_x
+    if along_x.shape[0] == 1:  # plane strain: one row on both grids
+        return along_x
     return np.stack([np.interp(yf, y, col) for col in along_x.T], axis=1)
 
 

@@ -8,7 +8,7 @@ import pytest
 
 from fretsim.api import load_case, run
 from fretsim.grid_error import companion_case
-from fretsim.sizing import MAX_ACCURACY_REFINEMENT, WIDTH_SHARE
+from fretsim.sizing import MAX_ACCURACY_REFINEMENT
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 DEPTHS = ("max_wear_depth_moving_um", "max_wear_depth_stationary_um")
@@ -80,14 +80,11 @@ def test_the_accuracy_rule_sizes_the_element_by_the_scar_and_the_paper_rule_by_t
     acc = run_check("mccoll_185N", ["model.dimension=2d"])
     paper = run_check("mccoll_185N", ["model.dimension=2d", "grid.rule=paper"])
     dx_paper = paper[0].grid.dx
-    hertz_a = dx_paper * 40 / 7
     assert acc[0].grid.dx < dx_paper / 2 and acc[0].grid.dx >= dx_paper / MAX_ACCURACY_REFINEMENT * (1 - 1e-9)
     reason = next(c.reason for c in acc[2].choices if c.key == "grid.elements")
     assert "grid.rule accuracy" in reason and "scar width" in reason
-    assert math.isclose(hertz_a * 7 / 40, dx_paper)
     loose = run_check("mccoll_185N", ["model.dimension=2d", "model.accuracy=0.2"])
     assert loose[0].grid.dx == pytest.approx(dx_paper)  # the paper's element is already a fine enough share
-    assert WIDTH_SHARE >= 2  # a width is known to about an element; the rest of the accuracy is the companion's
 
 
 def run_check(name, ov):
