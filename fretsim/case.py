@@ -143,8 +143,13 @@ SCHEMA: dict[str, dict[str, Key]] = {
                                           "exceeds model.accuracy), `none`, or a list of ring_bending "
                                           "(tubes, Eq. 23) and free_faces (3d: bodies that end across the "
                                           "contact, paper §2.1)", "auto"),
-        "accuracy": Key("fraction", "largest difference from the full model accepted when `auto` simplifies it",
-                        0.01, lo=1e-4, hi=0.5),
+        "accuracy": Key("fraction", "the depths' and scar widths' target: the largest difference from the full "
+                                    "model accepted when `auto` simplifies it, and (grid.rule accuracy) what the "
+                                    "grid is sized for", 0.01, lo=1e-4, hi=0.5),
+        "pressure_accuracy": Key("fraction", "opt-in: the pressure field's target (L2, relative), for which the grid "
+                                             "is refined (a 1 % field costs many times the elements: README); "
+                                             "omitted: the pressures are reported with their estimate only", None,
+                                 lo=1e-3, hi=0.5),
         "slip": Key("choice", "the fretting cycle: uniform (the paper's gross slip, 4δ everywhere), coulomb "
                               "(Coulomb friction through the cycle: partial and gross slip, the local slip in the "
                               "wear law), or auto: coulomb where uniform slip is not within model.accuracy of it",
@@ -237,6 +242,7 @@ class Case:
     gap_model: str = "auto"
     corrections: object = "auto"  # "auto", "none" or a tuple of CORRECTIONS
     accuracy: float = 0.01
+    pressure_accuracy: Optional[float] = None
     slip: str = "auto"
     stroke_model: str = "auto"
     wear_law: str = "archard"
@@ -332,7 +338,9 @@ class Case:
             "loading": loading,
             "model": {"dimension": self.dimension, "gap": self.gap_model,
                       "corrections": list(self.corrections) if isinstance(self.corrections, tuple) else self.corrections,
-                      "accuracy": self.accuracy, "slip": self.slip, "stroke": self.stroke_model,
+                      "accuracy": self.accuracy, **({} if self.pressure_accuracy is None else
+                                                    {"pressure_accuracy": self.pressure_accuracy}),
+                      "slip": self.slip, "stroke": self.stroke_model,
                       "wear_law": self.wear_law, "increments": self.increments},
             "solver": {"method": self.solver, "tolerance": self.tolerance},
             "jumping": jumping,
@@ -764,6 +772,7 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
                 friction_coefficient=load.get("friction_coefficient"),
                 tangential_stiffness=load.get("tangential_stiffness"), dimension=dimension,
                 gap_model=model["gap"], corrections=model["corrections"], accuracy=model["accuracy"],
+                pressure_accuracy=model.get("pressure_accuracy"),
                 slip=model["slip"], stroke_model=model["stroke"], wear_law=model["wear_law"],
                 increments=model["increments"],
                 solver=solver["method"],

@@ -314,7 +314,8 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
     model_part = sum(c.error for c in plan.choices)
     if filled.grid_error == "none" or filled.cycles == 0 or filled.elements is None:
         return grid_error.totals(summary, None, model_part)
-    companion = grid_error.companion_case(filled, setup.y_edges_free and not setup.grid.plane_strain)
+    line_contact = setup.y_edges_free and not setup.grid.plane_strain
+    companion = grid_error.companion_case(filled, line_contact)
     try:
         c_setup, _, _ = prepare_case(companion)
         _announce(f"grid error: the case again on a grid twice as coarse ({c_setup.grid.shape[1]} × "
@@ -326,17 +327,36 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
                              f"stopped ({str(exc)[:160]})")
         return grid_error.totals(summary, None, model_part)
     coarse = summarize(c_setup, last, 0, 0.0)
+    coarsest = _coarsest(filled, line_contact)
     part = grid_error.grid_estimates(summary, coarse, counter.last.pressure, setup.grid, last.pressure,
-                                     c_setup.grid)
+                                     c_setup.grid, coarsest)
     out = grid_error.totals(summary, part, model_part)
+    if not part["peak_converging"]:
+        counter.notes.append(grid_error.peak_note(summary["max_pressure_MPa"], coarse["max_pressure_MPa"],
+                                                  coarsest["max_pressure_MPa"], out["estimated_error_max_pressure"]))
     over = [f"{what} {out[key]:.2%}" for key, what in (("estimated_error_depth", "the depths"),
                                                         ("estimated_error_width", "the scar widths"))
             if out[key] > filled.accuracy]
+    if filled.pressure_accuracy is not None and out["estimated_error_pressure"] > filled.pressure_accuracy:
+        counter.notes.append(f"the estimated error of the pressure field {out['estimated_error_pressure']:.2%} "
+                             f"exceeds model.pressure_accuracy ({filled.pressure_accuracy:.2%})")
     if over:
         counter.notes.append(f"the estimated error of {' and of '.join(over)} exceeds model.accuracy "
                              f"({filled.accuracy:.2%}); a finer grid.elements (the companion grid's difference is "
                              f"most of it) or a smaller jumping.tolerance brings it down")
     return out
+
+
+def _coarsest(filled: Case, line_contact: bool) -> Optional[dict]:
+    """The summary of the run on a grid four times as coarse (whether the peak pressure converges), or None where
+    that grid cannot carry the run (too few elements for the contact, an unstable gap): the peak is then read
+    from two grids."""
+    from fretsim.plan import prepare as prepare_case
+    try:
+        c_setup, _, _ = prepare_case(grid_error.companion_case(filled, line_contact, times=2))
+        return summarize(c_setup, simulate(c_setup), 0, 0.0)
+    except (SimulationError, CaseError):
+        return None
 
 
 def _elapsed(counter, t0) -> float:

@@ -26,6 +26,12 @@ ELEMENTS_OVER_7A = 40  # paper Table 1
 # for what the coarser companion grid sees (fretsim.grid_error).
 WIDTH_SHARE = 3.0
 MAX_ACCURACY_REFINEMENT = 4.0  # per axis, over the paper's rule: beyond it the cost grows faster than it pays
+# The pressure field's L2 error, as the companion grid estimates it, falls about as the element along x over the
+# scar width: measured at the accuracy grid (scripts/study_grid_error.py, Table 4 cases), estimate ≈ 20-25·dx/W.
+# model.pressure_accuracy q asks for dx ≤ q·W/PRESSURE_SHARE.  A point contact's companion halves y too, so its
+# element along y is refined by the same factor over the paper's.
+PRESSURE_SHARE = 30.0
+MAX_PRESSURE_REFINEMENT = (16.0, 4.0)  # per axis over the paper's rule: along x; along y for a point contact
 LINE_ROWS = 27  # paper section 2.1.1: 370 µm across a 10 mm cylinder
 SCAR_MARGIN = 1.3
 
@@ -48,7 +54,8 @@ def _odd(n: float) -> int:
 
 
 def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float, cycles: int, k_total: float,
-              e_star: float, strokes: int = 1, refine: float = 1.0, accuracy: Optional[float] = None) -> Sizing:
+              e_star: float, strokes: int = 1, refine: float = 1.0, accuracy: Optional[float] = None,
+              pressure_accuracy: Optional[float] = None) -> Sizing:
     """The paper's element size and a domain holding the estimated final scar (both bodies' volume), plus
     ``strokes`` stroke amplitudes along x (the flat's wear reaches one stroke beyond the contact; seen through
     the stroke average, two).  Given ``accuracy``, the element along x is also at most accuracy/WIDTH_SHARE of
@@ -80,7 +87,27 @@ def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float
                    + (f", capped at {MAX_ACCURACY_REFINEMENT:g}× finer (the widths would need "
                       f"{accuracy * width / WIDTH_SHARE * 1e3:.3g} µm; the companion grid's estimate says how far "
                       f"they are)" if capped else ""))
-    if refine != 1.0 and why:
+    refine_y = refine
+    if pressure_accuracy is not None and cycles > 0:
+        width = 2 * max(scar_x, a)
+        cap_x, cap_y = MAX_PRESSURE_REFINEMENT
+        for_pressure = pressure_accuracy * width / PRESSURE_SHARE
+        if for_pressure < dx:
+            dx = max(for_pressure, paper / cap_x)
+            capped = dx > for_pressure
+            refine_y = max(refine, min(paper / dx, cap_y))
+            rule = f"7a/40 ÷ {cap_x:g}" if capped else (f"{pressure_accuracy:.2g} × the scar width {width:.3g} mm / "
+                                                        f"{PRESSURE_SHARE:g}")
+            why = (f"model.pressure_accuracy ({pressure_accuracy:.2g}): the element along x "
+                   f"{pressure_accuracy:.2g}/{PRESSURE_SHARE:g} of the estimated scar width {width:.3g} mm "
+                   f"(the pressure field's L2 error is about {PRESSURE_SHARE:g}·dx/width at most, measured)"
+                   + (f", capped at {cap_x:g}× finer than the paper's 7a/40 (it would need "
+                      f"{for_pressure * 1e3:.3g} µm; the companion grid's estimate says how far the field is)"
+                      if capped else "")
+                   + ("" if plane_strain or h.line else
+                      f"; along y the paper's rule refined ÷ {refine_y:.3g}"
+                      + (f" (capped at {cap_y:g})" if refine_y == cap_y else "")))
+    if refine != 1.0 and why and refine_y == refine:
         why += f"; along y the paper's rule refined ÷ {refine:.3g} for partial slip"
     reach = SCAR_MARGIN * max(scar_x, a) + strokes * stroke + 3 * dx
     nx = _odd(2 * reach / dx)
@@ -92,7 +119,7 @@ def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float
         ny, ly = LINE_ROWS, geometry.line_length
     else:
         scar_y = min(scar_y, 2 * (limits.reach_y or scar_y))
-        dy = 7 * h.half_width_y / ELEMENTS_OVER_7A / refine
+        dy = 7 * h.half_width_y / ELEMENTS_OVER_7A / refine_y
         ny = _odd(2 * (SCAR_MARGIN * max(scar_y, h.half_width_y) + 3 * dy) / dy)
         ly = ny * dy
     return Sizing(a, h.half_width_y, scar_x, (nx * dx, ly), (nx, ny),

@@ -46,6 +46,8 @@ def _default(spec: Key) -> str:
     if spec.default is REQUIRED:
         return "**required**"
     if spec.default is None:
+        if "omitted:" in spec.help:  # an opt-in: its absence is a choice of its own, said in the help
+            return "omitted"
         return "auto" if spec.kind not in ("choice",) else "–"
     if spec.kind == "fraction":
         return f"{spec.default:g} ({spec.default:.0%})" if spec.default >= 0.01 else f"{spec.default:g}"

@@ -14,6 +14,12 @@ The run's own estimates (history/error_estimate_*) are reported beside them.  Th
 defaults: depth ≤ 0.1 %, pressure ≤ 2 %, p(0) ≤ 0.5 %.
 
     python scripts/calibrate_stepping.py [--quick] [--dims 2d,3d] [--out scripts/out]
+    python scripts/calibrate_stepping.py --grid [--dims 2d,3d] [--pressure 0.05,0.02]
+
+The grid axis (`--grid`): the same cases on the paper's grid, the default (accuracy) grid, twice the default's
+elements and, with --pressure, the grids model.pressure_accuracy sizes, each against a converged run (finer grid,
+tighter stepping); every reported quantity's actual error and the run's estimate against its cost, the defaults
+marked (scripts/study_grid_error.py, which it runs: grid_error.csv and grid_error.png in scripts/results).
 
 References are cached in OUT/refs (delete them to recompute).  Prints a table and writes
 calibration.csv and calibration.png (requested tolerance against achieved depth and pressure errors).
@@ -99,7 +105,15 @@ def main() -> None:
     ap.add_argument("--dims", default="2d,3d")
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "out")
+    ap.add_argument("--grid", action="store_true", help="the grid axis: cost against the true error of each "
+                                                         "reported quantity over grids (study_grid_error.py)")
+    ap.add_argument("--pressure", default="", help="with --grid: model.pressure_accuracy values to add")
     args = ap.parse_args()
+    if args.grid:
+        from study_grid_error import grid_axis
+        grid_axis(args.cases.split(","), args.dims.split(","), [float(q) for q in args.pressure.split(",") if q],
+                  ROOT / "scripts" / "results")
+        return
     dims = ["2d"] if args.quick else args.dims.split(",")
     tols = [0.1, DEFAULT] if args.quick else TOLERANCES
     rows = []

@@ -70,15 +70,21 @@ def at_elements(name: str, dim: str, base, factor: float, tolerance: float, extr
             f"grid.elements=[{', '.join(map(str, elements))}]", *extra]
 
 
-def study(name: str, dim: str) -> list[dict]:
+def study(name: str, dim: str, pressures=()) -> list[dict]:
     default, t_default = run(name, [f"model.dimension={dim}"])
     paper, t_paper = run(name, [f"model.dimension={dim}", "grid.rule=paper", "grid.error_estimate=none"])
     alone, t_alone = run(name, [f"model.dimension={dim}", "grid.error_estimate=none"])
     double, t_double = run(name, at_elements(name, dim, default, 2, default.case.step_tolerance))
-    ref, _ = run(name, at_elements(name, dim, default, REF, default.case.step_tolerance / 10))
+    runs = [("paper 7a/40", paper, t_paper), ("default", default, t_default),
+            ("default, no companion", alone, t_alone), ("default ×2", double, t_double)]
+    for q in pressures:
+        out, seconds = run(name, [f"model.dimension={dim}", f"model.pressure_accuracy={q}"])
+        runs.append((f"pressure_accuracy {q:g}", out, seconds))
+    # the reference at least REF× the default's elements along x and twice the finest run's
+    factor = max(REF, 2 * max(out.case.elements[0] for _, out, _ in runs) / default.case.elements[0])
+    ref, _ = run(name, at_elements(name, dim, default, factor, default.case.step_tolerance / 10))
     rows = []
-    for label, out, seconds in (("paper 7a/40", paper, t_paper), ("default", default, t_default),
-                                ("default, no companion", alone, t_alone), ("default ×2", double, t_double)):
+    for label, out, seconds in runs:
         e = errors(out, ref)
         rows.append({"case": name, "dim": dim, "grid": label, "elements": "x".join(map(str, out.case.elements)),
                      "seconds": seconds, "cost_vs_paper": seconds / t_paper,
@@ -92,7 +98,8 @@ def chart(rows: list[dict], path: Path) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
     fig, axes = plt.subplots(1, 4, figsize=(16, 4), constrained_layout=True)
-    marks = {"paper 7a/40": "s", "default": "o", "default ×2": "^"}
+    marks = {"paper 7a/40": "s", "default": "o", "default ×2": "^",
+             **{g: "D" for g in dict.fromkeys(r["grid"] for r in rows) if g.startswith("pressure_accuracy")}}
     for ax, q in zip(axes, QUANTITIES):
         for label, m in marks.items():
             sel = [r for r in rows if r["grid"] == label]
@@ -115,24 +122,37 @@ def main() -> None:
     ap.add_argument("--dims", default="2d,3d")
     ap.add_argument("--cases", default=",".join(CASES))
     ap.add_argument("--out", default=str(ROOT / "scripts" / "results"))
+    ap.add_argument("--pressure", default="", help="model.pressure_accuracy values to add, e.g. 0.05,0.02")
     args = ap.parse_args()
+    grid_axis(args.cases.split(","), args.dims.split(","), [float(q) for q in args.pressure.split(",") if q],
+              Path(args.out))
+
+
+def grid_axis(cases: list[str], dims: list[str], pressures: list[float], out: Path) -> list[dict]:
+    """The study itself (also `calibrate_stepping.py --grid`): prints the table, writes the CSV and the chart."""
     rows = []
     print(f"{'case':17s} {'dim':3s} {'grid':22s} {'elements':>9s} {'cost':>5s}  "
           + "  ".join(f"{q:>19s}" for q in QUANTITIES))
     print(f"{'':60s}  " + "  ".join(f"{'actual':>9s} {'estim.':>9s}" for _ in QUANTITIES))
-    for dim in args.dims.split(","):
-        for name in args.cases.split(","):
+    for dim in dims:
+        for name in cases:
             if dim == "3d" and name.startswith("kirk"):
                 continue  # 10⁶ cycles: the 3D reference takes too long; Kirk's ends matter little (model_hierarchy)
-            for row in study(name, dim):
+            for row in study(name, dim, pressures):
                 rows.append(row)
                 print(f"{name:17s} {dim:3s} {row['grid']:22s} {row['elements']:>9s} {row['cost_vs_paper']:5.2f}  "
                       + "  ".join(f"{row['actual_' + q]:9.2e} {row['estimated_' + q]:9.2e}" for q in QUANTITIES),
                       flush=True)
-    out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
-    write_csv(rows, out / "grid_error.csv")
-    chart(rows, out / "grid_error.png")
+    stem = "grid_error_pressure" if pressures else "grid_error"
+    write_csv(rows, out / f"{stem}.csv")
+    chart(rows, out / f"{stem}.png")
+    for q in pressures:
+        p = [r for r in rows if r["grid"] == f"pressure_accuracy {q:g}"]
+        print(f"pressure_accuracy {q:g}: the field's actual error ≤ {q:g} in {sum(r['actual_pressure'] <= q for r in p)}"
+              f" of {len(p)}, its estimate ≤ {q:g} in {sum(r['estimated_pressure'] <= q for r in p)}, estimate ≥ actual"
+              f" in {sum(r['actual_pressure'] <= r['estimated_pressure'] for r in p)}; cost against the default "
+              f"(both with companions): median {np.median([r['seconds'] / d['seconds'] for r, d in zip(p, [r for r in rows if r['grid'] == 'default'])]):.2f}×")
     d = [r for r in rows if r["grid"] == "default"]
     honest = {q: sum(r[f"actual_{q}"] <= r[f"estimated_{q}"] for r in d) for q in QUANTITIES}
     within4 = {q: sum(r[f"estimated_{q}"] <= 4 * r[f"actual_{q}"] for r in d) for q in QUANTITIES}
@@ -140,6 +160,7 @@ def main() -> None:
     print(f"cost of the default (companion included) against the paper's grid: median "
           f"{np.median([r['cost_vs_paper'] for r in d]):.2f}×; without the companion "
           f"{np.median([r['cost_vs_paper'] for r in rows if r['grid'] == 'default, no companion']):.2f}×")
+    return rows
 
 
 if __name__ == "__main__":
