@@ -130,6 +130,18 @@ SCHEMA: dict[str, dict[str, Key]] = {
                                               "model.slip coulomb, the regime (partial or gross slip) and, for "
                                               "the uniform model, the energy law and the reported energy", None,
                                     lo=0.0, hi=10.0),
+        "blocks": Key("blocks", "a load history instead of one load: a list of blocks, each with normal_load, "
+                                "stroke, cycles (and friction_coefficient where it differs), applied in order; with "
+                                "`repeat` the list is applied that many times, with `cycles` it is repeated up to "
+                                "that many cycles (the last pass cut short)", None),
+        "spectrum": Key("blocks", "a load spectrum: a list of blocks with normal_load, stroke and fraction (of "
+                                  "loading.cycles), applied in order, in `repeat` passes (each block's cycles "
+                                  "split evenly among them)", None),
+        "repeat": Key("integer", "how many times loading.blocks is applied (or the passes a spectrum is split "
+                                 "into)", None, lo=1, hi=100_000),
+        "frequency": Key("frequency", "the fretting frequency: with it, the time to a wear limit is reported "
+                                      "too; omitted: cycles only", None, plausible=(1e-6, 1e6, "1 µHz to 1 MHz"),
+                         example="30 Hz"),
         "tangential_stiffness": Key("stiffness", "the rig's tangential stiffness: it takes Q/k of the stroke, the "
                                                  "contact the rest (as in fretting rigs and FE models of them); "
                                                  "omitted: a rigid rig", None,
@@ -149,7 +161,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "pressure_accuracy": Key("fraction", "opt-in: the pressure field's target (L2, relative), for which the grid "
                                              "is refined (a 1 % field costs many times the elements: README); "
                                              "omitted: the pressures are reported with their estimate only", None,
-                                 lo=1e-3, hi=0.5),
+                                 lo=1e-3, hi=0.5, example="5 %"),
         "slip": Key("choice", "the fretting cycle: uniform (the paper's gross slip, 4δ everywhere), coulomb "
                               "(Coulomb friction through the cycle: partial and gross slip, the local slip in the "
                               "wear law), or auto: coulomb where uniform slip is not within model.accuracy of it",
@@ -198,7 +210,23 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "snapshots": Key("cycle_list", "cycles at which fields are written (+ the last); auto: 0, N/4, N/2, "
                                        "3N/4, N", None)},
 }
-SECTIONS = ("name", "geometry", "materials", "loading", "model", "solver", "jumping", "grid", "output", "expected")
+SECTIONS = ("name", "geometry", "materials", "loading", "model", "solver", "jumping", "grid", "output", "limits",
+            "expected")
+# a wear limit per summary quantity (fretsim.limits): the run stops where the first is reached
+LIMITS_SCHEMA = {
+    "max_wear_depth_moving": Key("length", "the moving body's deepest wear", None),
+    "max_wear_depth_stationary": Key("length", "the stationary body's deepest wear", None),
+    "centre_wear_depth_moving": Key("length", "the moving body's deepest wear along y = 0", None),
+    "centre_wear_depth_stationary": Key("length", "the stationary body's deepest wear along y = 0", None),
+    "scar_width_moving": Key("length", "the moving body's scar width along y = 0", None),
+    "scar_width_stationary": Key("length", "the stationary body's scar width along y = 0", None),
+    "wear_volume_moving": Key("volume", "the moving body's worn volume", None),
+    "wear_volume_stationary": Key("volume", "the stationary body's worn volume", None),
+    "wall_loss": Key("fraction", "a tube's deepest wear over its wall thickness (tube_on_flat)", None, lo=1e-6,
+                     hi=1.0),
+}
+BLOCK_KEYS = ("normal_load", "stroke", "cycles", "friction_coefficient")
+MAX_BLOCKS = 10_000  # blocks after repeats: each restarts the stepping (a few solves)
 
 
 class CaseError(InputError):
@@ -238,6 +266,12 @@ class Case:
     cycles: int
     friction_coefficient: Optional[float] = None
     tangential_stiffness: Optional[float] = None  # N/mm, the rig's
+    blocks: Optional[tuple] = None  # a load history: one pass of Blocks (fretsim.loading); normal_load, stroke and
+    #                                  cycles are then its largest load and stroke and its total cycles
+    repeat: int = 1  # passes of ``blocks``
+    spectrum: bool = False  # ``blocks`` came from loading.spectrum (fractions of the cycles, split in passes)
+    frequency: Optional[float] = None  # Hz
+    limits: tuple = ()  # ((key, value in internal units), ...): fretsim.limits
     dimension: str = "auto"
     gap_model: str = "auto"
     corrections: object = "auto"  # "auto", "none" or a tuple of CORRECTIONS
@@ -276,6 +310,15 @@ class Case:
             mu = self.friction_coefficient
             return self.moving.energy_wear_coefficient * mu, self.stationary.energy_wear_coefficient * mu
         return self.moving.wear_coefficient, self.stationary.wear_coefficient
+
+    def history(self) -> tuple:
+        """The loading's blocks in the order applied (repeats and spectrum passes expanded), as
+        :class:`fretsim.loading.Block`; one block for a constant loading."""
+        from fretsim.loading import Block, expand
+        if self.blocks is None:
+            return (Block(self.normal_load, self.stroke, self.cycles, self.friction_coefficient,
+                          self.tangential_stiffness),)
+        return expand(self.blocks, self.repeat, self.cycles, self.spectrum)
 
     def fingerprint(self) -> str:
         """sha256 of what the case asks for, as given (automatic choices unfilled; the `expected` data left out,
@@ -320,8 +363,26 @@ class Case:
         if self.coarse_element is not None:
             grid["coarse_element"] = [format_quantity(d, "length") for d in self.coarse_element]
         grid["rule"], grid["error_estimate"] = self.grid_rule, self.grid_error
-        loading = {"normal_load": format_quantity(self.normal_load, "force"),
-                   "stroke": format_quantity(self.stroke, "length"), "cycles": self.cycles}
+        if self.blocks is None:
+            loading = {"normal_load": format_quantity(self.normal_load, "force"),
+                       "stroke": format_quantity(self.stroke, "length"), "cycles": self.cycles}
+        else:
+            def block(b) -> dict:
+                out = {"normal_load": format_quantity(b.normal_load, "force"),
+                       "stroke": format_quantity(b.stroke, "length")}
+                out.update({"fraction": b.fraction} if self.spectrum else {"cycles": b.cycles})
+                if b.friction_coefficient is not None and b.friction_coefficient != self.friction_coefficient:
+                    out["friction_coefficient"] = b.friction_coefficient
+                return out
+            loading = {"spectrum" if self.spectrum else "blocks": [block(b) for b in self.blocks]}
+            if self.spectrum:
+                loading.update(cycles=self.cycles, repeat=self.repeat)
+            elif sum(b.cycles for b in self.blocks) * self.repeat == self.cycles:
+                loading["repeat"] = self.repeat
+            else:  # repeated up to a number of cycles, the last pass cut short
+                loading["cycles"] = self.cycles
+        if self.frequency is not None:
+            loading["frequency"] = f"{self.frequency!r} Hz"
         if self.friction_coefficient is not None:
             loading["friction_coefficient"] = self.friction_coefficient
         if self.tangential_stiffness is not None:
@@ -346,6 +407,9 @@ class Case:
             "jumping": jumping,
             "grid": grid,
             "output": {"snapshots": list(self.snapshots) if self.snapshots is not None else "auto"},
+            **({"limits": {k: (f"{v!r}" if LIMITS_SCHEMA[k].kind == "fraction" else
+                               format_quantity(v, LIMITS_SCHEMA[k].kind)) for k, v in self.limits}}
+               if self.limits else {}),
         }
         if self.expected:
             out["expected"] = self.expected
@@ -546,6 +610,8 @@ class _Reader:
                 self.fail(path, f"expected auto, none, or a list of {', '.join(CORRECTIONS)}; got {excerpt(value)}")
                 return None
             return tuple(sorted(set(items)))
+        if kind == "blocks":  # read item by item by _read_blocks, with the loading's own key specs
+            return value
         if kind == "cycle_list":
             if not isinstance(value, list):
                 self.fail(path, "expected a list of cycle numbers, e.g. [1000, 5000, 18000]")
@@ -665,6 +731,73 @@ def _expected(spec: Key) -> str:
     return spec.help
 
 
+def _read_blocks(r: "_Reader", raw_load: dict, load: dict, given: list) -> tuple[Optional[tuple], int]:
+    """loading.blocks or loading.spectrum: one pass of Blocks, and the number of passes."""
+    from fretsim.loading import Block
+    if len(given) > 1:
+        r.fail("loading", "both blocks and spectrum given; a loading is one or the other")
+        return None, 1
+    kind = given[0]
+    spectrum = kind == "spectrum"
+    for k in ("normal_load", "stroke") + (() if spectrum else ("cycles",)):
+        if raw_load.get(k) is not None and not (k == "cycles" and raw_load.get("repeat") is None):
+            r.fail(f"loading.{k}", f"given with loading.{kind}: the blocks carry it" + (
+                "; loading.cycles with blocks repeats them up to that many cycles, so it goes without "
+                "loading.repeat" if k == "cycles" else ""))
+    items = raw_load[kind]
+    if not isinstance(items, list) or not items or len(items) > MAX_BLOCKS:
+        r.fail(f"loading.{kind}", f"expected a list of 1 to {MAX_BLOCKS} mappings, each with normal_load, stroke "
+                                  f"and {'fraction' if spectrum else 'cycles'}")
+        return None, 1
+    fields = ("normal_load", "stroke", "fraction" if spectrum else "cycles", "friction_coefficient")
+    spec = dict(SCHEMA["loading"])
+    spec["fraction"] = Key("fraction", "the block's share of loading.cycles", REQUIRED, lo=0.0, hi=1.0)
+    spec["friction_coefficient"] = replace(spec["friction_coefficient"], default=load.get("friction_coefficient"))
+    out = []
+    for i, item in enumerate(items):
+        path = f"loading.{kind}[{i}]"
+        if not isinstance(item, dict):
+            r.fail(path, f"expected a mapping with {', '.join(fields[:3])}, got {excerpt(item)}")
+            continue
+        r.unknown(item, fields, path)
+        vals = {k: r.key(item, k, spec[k], f"{path}.{k}") for k in fields}
+        if any(vals[k] is None for k in fields[:3]):
+            continue
+        cycles = 0 if spectrum else vals["cycles"]
+        out.append(Block(vals["normal_load"], vals["stroke"], cycles, vals["friction_coefficient"],
+                         load.get("tangential_stiffness"), vals["fraction"] if spectrum else None))
+    if len(out) != len(items):
+        return None, 1
+    if spectrum:
+        total = sum(b.fraction for b in out)
+        if abs(total - 1.0) > 1e-6:
+            r.fail(f"loading.spectrum", f"the fractions add up to {total:.6g}; expected 1")
+            return None, 1
+        if load.get("cycles") is None:
+            return None, 1
+    elif sum(b.cycles for b in out) == 0:
+        r.fail(f"loading.blocks", "every block has 0 cycles")
+        return None, 1
+    return tuple(out), load.get("repeat") or 1
+
+
+def _read_limits(r: "_Reader", raw: Any) -> tuple:
+    if raw is None:
+        return ()
+    if not isinstance(raw, dict) or not raw:
+        r.fail("limits", f"expected a mapping of wear limits, e.g. {{max_wear_depth_stationary: 2 um}}, got "
+                         f"{excerpt(raw)}")
+        return ()
+    r.unknown(raw, LIMITS_SCHEMA, "limits")
+    out = []
+    for k, spec in LIMITS_SCHEMA.items():
+        if k in raw:
+            v = r.key(raw, k, spec, f"limits.{k}")
+            if v is not None:
+                out.append((k, v))
+    return tuple(out)
+
+
 def _validate(raw: dict, problems: list, source: str, default_name: str, overrides: tuple) -> Optional[Case]:
     r = _Reader(problems, source)
     r.unknown(raw, set(SECTIONS), "")
@@ -710,12 +843,21 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
         if len(problems) == before:
             materials[body] = Material(*vals)
 
-    def read(section: str, required: bool = False) -> dict:
-        mapping = r.section(raw, section, SCHEMA[section], required=required)
-        return {k: r.key(mapping, k, spec, f"{section}.{k}") for k, spec in SCHEMA[section].items()} \
+    def read(section: str, required: bool = False, schema: Optional[dict] = None) -> dict:
+        schema = schema or SCHEMA[section]
+        mapping = r.section(raw, section, schema, required=required)
+        return {k: r.key(mapping, k, spec, f"{section}.{k}") for k, spec in schema.items()} \
             if mapping is not None else {}
 
-    load = read("loading", required=True)
+    raw_load = raw.get("loading") if isinstance(raw.get("loading"), dict) else {}
+    given = [k for k in ("blocks", "spectrum") if raw_load.get(k) is not None]
+    load_schema = SCHEMA["loading"]
+    if given:  # a load history: the single load's keys are the blocks'
+        relaxed = ("normal_load", "stroke") + (("cycles",) if given == ["blocks"] else ())
+        load_schema = {k: (replace(v, default=None) if k in relaxed else v) for k, v in load_schema.items()}
+    load = read("loading", required=True, schema=load_schema)
+    blocks, repeat = _read_blocks(r, raw_load, load, given) if given else (None, 1)
+    limits = _read_limits(r, raw.get("limits"))
     model = read("model")
     solver = read("solver")
     jumping_raw = raw.get("jumping") if isinstance(raw.get("jumping"), dict) else {}
@@ -767,8 +909,24 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
         if not problems:
             r.fail("geometry", "incomplete")
         return None
+    if blocks is not None:
+        from fretsim.loading import expand
+        applied = expand(blocks, repeat, load.get("cycles"), given == ["spectrum"])
+        if len(applied) > MAX_BLOCKS:
+            r.fail("loading.repeat", f"{len(applied)} blocks in all; at most {MAX_BLOCKS} (each restarts the "
+                                     f"stepping): fewer passes, or longer blocks")
+        load["normal_load"] = max(b.normal_load for b in blocks)
+        stroke = max(b.stroke for b in blocks)
+        load["cycles"] = sum(b.cycles for b in applied)
+    if dict(limits).get("wall_loss") is not None and geometry is not None and geometry.kind != "tube_on_flat":
+        r.fail("limits.wall_loss", f"a wall loss is a tube's (tube_on_flat); a {geometry.kind} has no wall: use "
+                                   f"max_wear_depth_moving")
+    if problems:
+        return None
     return Case(name=name, geometry=geometry, moving=materials["moving"], stationary=materials["stationary"],
                 normal_load=load["normal_load"], stroke=stroke, cycles=load["cycles"],
+                blocks=blocks, repeat=repeat, spectrum=given == ["spectrum"], frequency=load.get("frequency"),
+                limits=limits,
                 friction_coefficient=load.get("friction_coefficient"),
                 tangential_stiffness=load.get("tangential_stiffness"), dimension=dimension,
                 gap_model=model["gap"], corrections=model["corrections"], accuracy=model["accuracy"],

@@ -252,6 +252,31 @@ def _estimates(s: dict) -> str:
             f"{s['estimated_error_max_pressure']:.1e} ({stepping}).")
 
 
+def _limits(s: dict, c) -> str:
+    """The wear-limit sentence: which limit was reached and when (cycles, and time at loading.frequency), or how
+    near each came."""
+    import math
+    from fretsim.limits import LIMIT_KEYS
+    if not c.limits:
+        return ""
+    def shown(key, v):
+        kind, unit, f = LIMIT_KEYS[key]
+        return f"{v:.1%}" if kind == "fraction" else f"{v * f:.4g} {unit.replace('um', 'µm').replace('mm3', 'mm³')}"
+    limits = dict(c.limits)
+    if s.get("limit_reached"):
+        key, n = s["limit_reached"], s["cycles_to_limit"]
+        err = s.get("estimated_error_cycles_to_limit", float("nan"))
+        text = f" Wear limit reached: {key} = {shown(key, limits[key])} at cycle {n:,.0f}"
+        if math.isfinite(err):
+            text += f" (± {err:.1e} relative)"
+        if c.frequency:
+            hours = s["time_to_limit_h"]
+            text += (f", {hours:,.4g} h at {c.frequency:g} Hz" + (f" ({hours / 8766:.3g} years of continuous "
+                                                                  f"fretting)" if hours > 24 * 30 else ""))
+        return text + "."
+    return f" No wear limit reached within {s['cycles']:,} cycles ({', '.join(f'{k} = {shown(k, v)}' for k, v in limits.items())})."
+
+
 def _paragraph(outcome) -> str:
     s, c, g = outcome.summary, outcome.case, outcome.setup.grid
     cells = f"{g.shape[1]} elements" if g.plane_strain else f"{g.shape[1]} × {g.shape[0]} elements"
@@ -265,7 +290,9 @@ def _paragraph(outcome) -> str:
     refined = f", contact on a {c.coarse_element[0] * 1e3:.3g} µm coarse grid" if c.coarse_element else ""
     model = (f"gap model {c.gap_model}" if c.slip == "uniform" and c.stroke_model == "mid_stroke" else
              f"{c.slip} slip, stroke {c.stroke_model.replace('_', '-')}, {c.increments} increments per half-stroke")
-    text = (f"{c.name}: {s['cycles']} cycles, {c.dimension.upper()} {c.geometry.kind}, {cells} of {size}{refined}, "
+    reached = (outcome.last.block + 1) if outcome.last is not None else 0
+    blocks = "" if c.blocks is None else f" ({reached} of the loading's {len(c.history())} blocks)"
+    text = (f"{c.name}: {s['cycles']} cycles{blocks}, {c.dimension.upper()} {c.geometry.kind}, {cells} of {size}{refined}, "
             f"{model}, solver {c.solver}, {stepping}; {s['contact_solves']} contact solves in "
             f"{s['wall_time_s']:.2f} s.")
     text += " " + _regime(s, c)
@@ -276,7 +303,7 @@ def _paragraph(outcome) -> str:
                  f"{s['centre_wear_depth_moving_um']:.3g} µm (max {s['max_wear_depth_moving_um']:.3g} µm), volume "
                  f"{s['wear_volume_moving_mm3']:.4g} mm³. Volume against its invariant "
                  f"({outcome.setup.cycle.invariant}): {s['archard_volume_error']:.1e}. "
-                 f"{_estimates(s)}")
+                 f"{_estimates(s)}" + _limits(s, c))
     else:
         text += f" Contact only: peak pressure {s['max_pressure_MPa']:.4g} MPa."
     return text + f" Results: {outcome.output}"
@@ -472,6 +499,62 @@ def export(results_file: Path, csv_dir: Path, debug: bool) -> None:
 
     res = read_results(results_file)
     _write_and_list(lambda: export_csv(res, csv_dir), str(csv_dir))
+
+
+@main.command()
+@click.argument("case_file", type=click.Path(path_type=Path))
+@click.option("--measured", "measured_file", required=True, type=click.Path(path_type=Path),
+              help="CSV of measured wear at given cycles: `cycle [cycles],max_wear_depth_stationary [um],…` (any "
+                   "wear-limit quantity), or profiles: `cycle [cycles],x [mm],wear_depth_stationary [um]`.")
+@click.option("--fit", "fit_keys", multiple=True, metavar="KEY.PATH",
+              help="A case value to fit (repeatable); default: both wear coefficients.")
+@click.option("--set", "overrides", multiple=True, metavar="KEY.PATH=VALUE", help="Override a case value.")
+@click.option("-o", "--output", type=click.Path(dir_okay=False, path_type=Path),
+              help="Write the case with the fitted values to this file.")
+@click.option("--debug", is_flag=True, help="Show tracebacks.")
+@_boundary
+def fit(case_file: Path, measured_file: Path, fit_keys: tuple, overrides: tuple, output: Path | None,
+        debug: bool) -> None:
+    """Fit case values (both wear coefficients by default) to measured wear by bounded least squares over runs
+    of CASE_FILE; print them with 95 % confidence intervals and the residuals."""
+    import numpy as np
+
+    from fretsim.fit import DEFAULT_FIT, fit as fit_case, fitted_case_text, read_measured, shown
+    from fretsim.units import INTERNAL
+    from fretsim.yamlread import read_text
+
+    text = read_text(case_file, "case file")
+    measured = read_measured(measured_file)
+    click.echo(f"fitting {', '.join(fit_keys or DEFAULT_FIT)} to {measured.values.size} measured value(s) of "
+               f"{measured_file}", err=True)
+    try:
+        res = fit_case(text, str(case_file), measured, fit_keys or DEFAULT_FIT, overrides,
+                       progress=lambda n: click.echo(f"\r  {n} runs", nl=False, err=True))
+    except RuntimeError as exc:
+        raise Fail(f"the fit stopped: {exc}", 3) from None
+    click.echo("", err=True)
+    for k, v0, v, lo, hi, kind in zip(res.keys, res.start, res.values, res.low, res.high, res.kinds):
+        def short(x):
+            return f"{x:.4g}" + ("" if kind == "number" else f" {INTERNAL[kind]}")
+        ci = f"95 % CI [{short(lo)}, {short(hi)}]" if np.isfinite(lo) else "no CI"
+        click.echo(f"{k} = {short(v)}  ({ci}; started at {short(v0)})")
+    click.echo(f"{res.runs} runs, {res.dof} degree(s) of freedom. "
+               + (res.message if res.dof <= 0 or not res.converged else ""))
+    click.echo("residuals (model/measured − 1; a profile's against its deepest point):")
+    for n, key, x, meas, mod, r in zip(measured.cycles, measured.keys, measured.x, measured.values, res.model,
+                                       res.residuals):
+        where = f" at x = {x:.4g} mm" if np.isfinite(x) else ""
+        click.echo(f"  cycle {n:>10,}  {key}{where}: measured {shown(meas, key, measured)}, model "
+                   f"{shown(mod, key, measured)}, {r:+.2%}")
+    if output is not None:
+        tmp = output.with_name(f".{output.name}.part")
+        try:
+            tmp.write_text(fitted_case_text(text, res), encoding="utf-8")
+            os.replace(tmp, output)
+        finally:
+            if tmp.exists():
+                tmp.unlink()
+        click.echo(f"fitted case: {output}")
 
 
 class _InitCommand(click.Command):

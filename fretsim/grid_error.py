@@ -34,6 +34,7 @@ DEPTHS = ("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "centre_we
           "centre_wear_depth_stationary_um")
 WIDTHS = ("scar_width_moving_mm", "scar_width_stationary_mm")
 KEYS = ("estimated_error_depth", "estimated_error_width", "estimated_error_pressure", "estimated_error_max_pressure")
+LIMIT_KEY = "estimated_error_cycles_to_limit"
 
 
 def _odd(n: float) -> int:
@@ -103,3 +104,20 @@ def peak_note(fine: float, coarse: float, coarsest: float, estimate: float) -> s
     return (f"the peak pressure is not yet converging on these grids ({coarsest:.4g}, {coarse:.4g}, {fine:.4g} MPa "
             f"on grids 4×, 2× and 1× this run's element): its estimate ({estimate:.1%}) is the spread they show, a "
             f"scale rather than a bound; model.pressure_accuracy sizes a grid that resolves it")
+
+
+def cycles_to_limit_estimate(fine: dict, coarse: Optional[dict], limit: Optional[tuple],
+                             model_part: float = 0.0) -> float:
+    """The relative error of ``cycles_to_limit``: the depths' stepping and model parts over the quantity's growth
+    exponent d ln q / d ln N (an error ε in a depth growing as √N is one of 2ε in its cycle), the crossing's
+    interpolation spread, and the grid's part read directly from the companion's own crossing.  NaN where there
+    is no crossing, no companion, or the companion reached no limit."""
+    n = fine.get("cycles_to_limit", float("nan"))
+    if limit is None or coarse is None or not math.isfinite(n) or n <= 0:
+        return float("nan")
+    _, _, spread, exponent = limit
+    exponent = max(exponent, 0.1)  # a quantity that has all but stopped growing: its crossing is ill-defined
+    n_coarse = coarse.get("cycles_to_limit", float("nan"))
+    if not math.isfinite(n_coarse):
+        return float("nan")
+    return float((fine["error_estimate_depth"] + model_part) / exponent + spread / n + abs(n - n_coarse) / n)

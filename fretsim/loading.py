@@ -2,12 +2,13 @@
 
 A block is what a fretting rig holds constant for a while: the normal load P, the stroke (slip amplitude δ of
 the applied displacement, so the rig travels 4δ per cycle), the number of cycles, and the friction coefficient
-and the rig's tangential stiffness where the cycle model uses them.  Today a case has one block; the loop reads
-the loading instead of loose numbers, so a load history is more blocks, not a new branch.
+and the rig's tangential stiffness where the cycle model uses them.  A constant loading is one block; a load
+history (``loading.blocks``, or a spectrum of fractions of the cycles) is several, applied in order, each with
+its own cycle model; the loop restarts its stepping at each block's start as it does at the run's.
 """
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import Optional
 
 
@@ -20,6 +21,41 @@ class Block:
     cycles: int
     friction_coefficient: Optional[float] = None
     tangential_stiffness: Optional[float] = None  # N/mm, the rig's; None: a rigid rig
+    fraction: Optional[float] = None  # a spectrum's block: its share of the cycles (cycles then set by expand)
+
+
+def expand(blocks: tuple, repeat: int = 1, cycles: Optional[int] = None, spectrum: bool = False) -> tuple:
+    """The blocks in the order applied.
+
+    Blocks: ``repeat`` passes; or, given ``cycles``, as many passes as reach that many cycles, the last cut
+    short.  Spectrum: each block's share of ``cycles`` split evenly over ``repeat`` passes (the remainders to the
+    first passes, so the totals are exact).
+    """
+    if spectrum:
+        shares = [int(round(b.fraction * cycles)) for b in blocks]
+        shares[-1] = cycles - sum(shares[:-1])  # exact total whatever the rounding
+        out = []
+        for i in range(repeat):
+            for b, n in zip(blocks, shares):
+                part = n // repeat + (1 if i < n % repeat else 0)
+                if part:
+                    out.append(replace(b, cycles=part))
+        return tuple(out)
+    if cycles is None:
+        return tuple(b for _ in range(repeat) for b in blocks if b.cycles)
+    per_pass = sum(b.cycles for b in blocks)
+    out, left = [], cycles
+    while left > 0 and per_pass > 0:
+        for b in blocks:
+            n = min(b.cycles, left)
+            if n:
+                out.append(replace(b, cycles=n))
+            left -= n
+            if left <= 0:
+                break
+        if len(out) > 10_001:  # the caller refuses more than MAX_BLOCKS; stop counting
+            break
+    return tuple(out)
 
 
 @dataclass(frozen=True)
@@ -45,12 +81,28 @@ class Loading:
 
     def block_at(self, cycle: int) -> Block:
         """The block that cycle ``cycle`` + 1 belongs to (the last block from its start on)."""
+        return self.blocks[self.index_at(cycle)]
+
+    def index_at(self, cycle: int) -> int:
+        """The index of the block that cycle ``cycle`` + 1 belongs to (the last block from its start on)."""
         start = 0
-        for b in self.blocks:
+        for i, b in enumerate(self.blocks):
             if cycle < start + b.cycles:
-                return b
+                return i
             start += b.cycles
-        return self.blocks[-1]
+        return len(self.blocks) - 1
+
+    @property
+    def boundaries(self) -> tuple[int, ...]:
+        """The cycles at which a block ends and the next begins."""
+        ends, n = [], 0
+        for b in self.blocks[:-1]:
+            n += b.cycles
+            ends.append(n)
+        return tuple(ends)
+
+    def start_of(self, index: int) -> int:
+        return sum(b.cycles for b in self.blocks[:index])
 
 
 def single(normal_load: float, stroke: float, cycles: int, friction_coefficient: Optional[float] = None,

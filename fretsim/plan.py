@@ -19,9 +19,9 @@ from fretsim.compliance import HalfSpace, add
 from fretsim.cycle import CoulombCycle, UniformCycle
 from fretsim.cycle.coulomb import gross_slip_stroke
 from fretsim.grid import Grid
-from fretsim.loading import Loading, single
+from fretsim.loading import Loading
 from fretsim.reference import effective_modulus
-from fretsim.simulate import Setup, SimulationError
+from fretsim.simulate import DEPTH_SHARE, Setup, SimulationError
 from fretsim.sizing import ELEMENTS_OVER_7A, Sizing, auto_grid
 from fretsim.solvers import solve
 from fretsim.stability import Spectrum, default_linear_jump, wear_spectrum
@@ -396,7 +396,40 @@ def estimate_cost(setup) -> tuple[int, float]:
 
 # --- prepare ----------------------------------------------------------------------------------------------------
 
-def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0) -> tuple[Setup, Case, Plan]:
+PILOT_MARGIN = 1.3  # the grid of a run with wear limits holds the wear of this many times the pilot's cycles
+
+
+def pilot_cycles(case: Case) -> Optional[float]:
+    """Where a run with wear limits will stop, roughly: the case on the paper's grid, in 2D where the geometry
+    has it, at a loose stepping tolerance, no companion (None if no limit is reached or the pilot fails).  Its
+    only use is sizing: a limit's run is sized for the wear at the limit, not for loading.cycles, which is then
+    only an upper bound (a scar sized for 10⁹ cycles would make the elements far too coarse for the scar at
+    the limit)."""
+    from fretsim.simulate import simulate
+    pilot = case.with_choices(dimension="2d" if case.geometry.has_2d else "3d", corrections="none",
+                              grid_rule="paper", grid_error="none", step_tolerance=max(case.step_tolerance, 0.03),
+                              pressure_accuracy=None, snapshots=(0,), scheme="bdf2")
+    key = repr(pilot.to_dict())  # auto's proxies prepare variants of the case: one pilot serves them all
+    if key in _PILOTS:
+        return _PILOTS[key]
+    _announce("wear limits: a pilot run on the paper's grid to find roughly where the limit is reached")
+    try:
+        setup, _, _ = prepare(pilot, _pilot=float("nan"))
+        last = simulate(setup)
+        found = float(last.limit[1]) if last.limit else None
+    except (SimulationError, CaseError):
+        found = None
+    if len(_PILOTS) > 64:
+        _PILOTS.clear()
+    _PILOTS[key] = found
+    return found
+
+
+_PILOTS: dict = {}
+
+
+def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0,
+            _pilot: Optional[float] = None) -> tuple[Setup, Case, Plan]:
     """Unpack a case into arrays and numbers; fill the automatic choices into the returned case.
 
     A linear jump beyond the explicit stability limit is refused (CaseError) unless ``allow_unstable``
@@ -442,7 +475,20 @@ def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0) -> t
         plan.warnings.append(f"the Hertz half-width a = {hertz.half_width_x:.4g} mm is {hertz.half_width_x / (2 * reach):.0%}"
                              f" of the radius: the half-space model assumes a ≪ R (beyond about "
                              f"{SMALL_CONTACT:.0%} its pressures are off by more than a few per cent)")
-    dimension = plan.add(choose_dimension(case, e_star))
+    sized = case.cycles
+    if case.limits and case.cycles > 0 and (case.elements is None or "auto" in (case.dimension, case.corrections)):
+        if _pilot is None:
+            _pilot = pilot_cycles(case)
+            _pilot = float("nan") if _pilot is None else _pilot
+        if _pilot == _pilot and PILOT_MARGIN * _pilot < case.cycles:  # reached well before loading.cycles
+            sized = max(1, int(PILOT_MARGIN * _pilot))
+            plan.warnings.append(f"wear limits: the grid and auto's proxies take the wear of {sized:,} cycles, "
+                                 f"{PILOT_MARGIN:g}× where a pilot on the paper's grid reached a limit "
+                                 f"({_pilot:,.0f}); loading.cycles ({case.cycles:,}) is the upper bound")
+    # auto's proxies compare the models' depths and widths: at a limit the limited one is pinned, so they run
+    # without the limits, over the cycles the run will take
+    proxy_case = case.with_choices(limits=(), cycles=sized) if case.limits else case
+    dimension = plan.add(choose_dimension(proxy_case, e_star))
     plane = dimension == "2d"
     if plane and g.axial_profile:
         plan.warnings.append(f"the {g.kind}'s axial profile (its drop along y) is not modelled in 2D: a 2D run is "
@@ -451,12 +497,16 @@ def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0) -> t
     # one grid whatever the stepping, so that schemes compare on it; an explicit scheme whose stability limit falls
     # below a cycle on it is refused with the advice of grid.rule: paper
     accuracy = case.accuracy if case.grid_rule == "accuracy" else None
-    sizing = auto_grid(g, plane, case.normal_load, case.stroke, case.cycles, k_m + k_s, e_star, refine=_refine,
-                       accuracy=accuracy, pressure_accuracy=case.pressure_accuracy)
+    history = case.history()
+    # a load history: the smallest load's contact resolved, the scar of every block's wear held
+    size_load = min(b.normal_load for b in history)
+    volume = (k_m + k_s) * _worn_work(history, sized)
+    sizing = auto_grid(g, plane, size_load, case.stroke, case.cycles, k_m + k_s, e_star, refine=_refine,
+                       accuracy=accuracy, pressure_accuracy=case.pressure_accuracy, volume=volume)
     gap_probe = choose_gap_model(case, Grid.centred(3, 1, sizing.domain[0] / sizing.elements[0], 1.0, True))
     if gap_probe.value == "stroke_average":  # its wear reaches two strokes beyond the contact
-        sizing = auto_grid(g, plane, case.normal_load, case.stroke, case.cycles, k_m + k_s, e_star, strokes=2,
-                           refine=_refine, accuracy=accuracy, pressure_accuracy=case.pressure_accuracy)
+        sizing = auto_grid(g, plane, size_load, case.stroke, case.cycles, k_m + k_s, e_star, strokes=2,
+                           refine=_refine, accuracy=accuracy, pressure_accuracy=case.pressure_accuracy, volume=volume)
     c_domain, c_elements = choose_grid(case, plane, sizing)
     domain, elements = plan.add(c_domain), plan.add(c_elements)
     if len(domain) < (1 if plane else 2) or len(elements) < (1 if plane else 2):
@@ -511,7 +561,7 @@ def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0) -> t
         plan.add(Choice("grid.coarse_element", case.coarse_element, f"given: contact solved on {cnx} x {cny} "
                                                                     f"elements, pressure refined to {nx} x {ny} "
                                                                     f"(Akima weights, Eqs. 11-12)", True))
-    corrections = plan.add(choose_corrections(case, grid, e_star, sizing.scar_half_width))
+    corrections = plan.add(choose_corrections(proxy_case, grid, e_star, sizing.scar_half_width))
     nu = max(case.moving.poissons_ratio, case.stationary.poissons_ratio)
     if "free_faces" in corrections and nu > 0.45:
         plan.warnings.append(f"Poisson's ratio {nu:g}: the free faces' finite-element block (bilinear elements) "
@@ -538,18 +588,31 @@ def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0) -> t
     load = case.normal_load / g.line_length if plane else case.normal_load
     volume_factor = g.line_length if plane else 1.0
     tangential = transition = None
-    if case.friction_coefficient is not None:
+    history = case.history()
+    regime_case = case  # the block nearest partial slip decides the cycle model of a load history
+    if any(b.friction_coefficient is not None for b in history):
         tangential = tangential_operator(case, grid)
-        transition = gross_slip_stroke(tangential, solve(compliance, g.separation(grid), load,
-                                                         tol=case.tolerance).pressure, case.friction_coefficient)
-    slip = choose_slip(case, transition)
+        worst = None
+        for b in dict.fromkeys(history):
+            if b.friction_coefficient is None:
+                continue
+            p_b = solve(compliance, g.separation(grid), b.normal_load / g.line_length if plane else b.normal_load,
+                        tol=case.tolerance).pressure
+            t_b = gross_slip_stroke(tangential, p_b, b.friction_coefficient)
+            if worst is None or t_b / b.stroke > worst[0]:
+                worst = (t_b / b.stroke, t_b, b)
+        _, transition, b = worst
+        if len(history) > 1:
+            regime_case = case.with_choices(normal_load=b.normal_load, stroke=b.stroke,
+                                            friction_coefficient=b.friction_coefficient)
+    slip = choose_slip(regime_case, transition)
     if _refine == 1.0 and case.elements is None:
         # the same case on the grid partial slip needs, within a cap: a tiny stroke's annulus would need thousands
         # (counted from the paper's element along both axes: the accuracy rule refines x alone)
         refine = partial_slip_refinement(case, slip.value, transition, hertz.half_width_x,
                                          7 * hertz.half_width_x / ELEMENTS_OVER_7A)
         if refine > 1.0:
-            return prepare(case, allow_unstable, _refine=min(refine, MAX_PARTIAL_SLIP_REFINEMENT))
+            return prepare(case, allow_unstable, _refine=min(refine, MAX_PARTIAL_SLIP_REFINEMENT), _pilot=_pilot)
     refine = partial_slip_refinement(case, slip.value, transition, hertz.half_width_x, grid.dx)
     if refine > 1.01:  # short of the target beyond round-off
         width = PARTIAL_SLIP_ELEMENTS * grid.dx / refine
@@ -622,21 +685,34 @@ def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0) -> t
         plan.warnings.append(f"snapshots {list(beyond)} lie beyond the run's {case.cycles} cycles and are skipped")
     snapshots = tuple(sorted({s for s in snapshots if s <= case.cycles} | {case.cycles}))
     loading = loading_of(case)
-    if slip == "uniform" and stroke_model == "mid_stroke":
-        model = UniformCycle(grid=grid, wear_op=wear_operator(solve_op.grid, case.stroke, k_m, k_s, gap_model),
-                             stroke=case.stroke, load=load, total_load=case.normal_load, k_moving=k_m,
-                             k_stationary=k_s, gap_model=gap_model, friction_coefficient=case.friction_coefficient)
-    else:
+
+    def cycle_model(block):
+        """The fretting-cycle model of one block of the loading."""
+        b_load = block.normal_load / g.line_length if plane else block.normal_load
+        mu = block.friction_coefficient
+        if slip == "uniform" and stroke_model == "mid_stroke":
+            b_km, b_ks = (k_m, k_s) if case.wear_law == "archard" else (
+                case.moving.energy_wear_coefficient * mu, case.stationary.energy_wear_coefficient * mu)
+            return UniformCycle(grid=grid, wear_op=wear_operator(solve_op.grid, block.stroke, b_km, b_ks, gap_model),
+                                stroke=block.stroke, load=b_load, total_load=block.normal_load, k_moving=b_km,
+                                k_stationary=b_ks, gap_model=gap_model, friction_coefficient=mu)
         law_m, law_s = ((case.moving.wear_coefficient, case.stationary.wear_coefficient) if case.wear_law == "archard"
                         else (case.moving.energy_wear_coefficient, case.stationary.energy_wear_coefficient))
-        model = CoulombCycle(grid=grid, compliance=compliance, tangential=tangential, stroke=case.stroke, load=load,
-                             total_load=case.normal_load, friction_coefficient=case.friction_coefficient,
-                             k_moving=law_m, k_stationary=law_s, law=case.wear_law, slip=slip,
-                             stroke_model=stroke_model, gap_model=gap_model, increments=case.increments,
-                             volume_factor=volume_factor)
+        return CoulombCycle(grid=grid, compliance=compliance, tangential=tangential, stroke=block.stroke, load=b_load,
+                            total_load=block.normal_load, friction_coefficient=mu,
+                            k_moving=law_m, k_stationary=law_s, law=case.wear_law, slip=slip,
+                            stroke_model=stroke_model, gap_model=gap_model, increments=case.increments,
+                            volume_factor=volume_factor)
+
+    built: dict = {}  # a repeated block shares its model (and its cached operators)
+    block_models = tuple(built.setdefault(b, cycle_model(b)) for b in loading.blocks)
+    model = block_models[0]
     reach = stroke_reach(grid.dx, case.stroke)
     band = (2 * reach if gap_model == "stroke_average" and stroke_model == "mid_stroke" else reach) + 1
-    setup = Setup(grid=grid, compliance=compliance, gap=g.separation(grid), loading=loading, cycle=model, band=band,
+    setup = Setup(grid=grid, compliance=compliance, gap=g.separation(grid), loading=loading, cycle=model,
+                  block_cycles=block_models if len(block_models) > 1 else (),
+                  wear_limits=dict(case.limits), wall=getattr(g, "wall", None) if case.limits else None,
+                  limit_tolerance=case.step_tolerance * DEPTH_SHARE, frequency=case.frequency, band=band,
                   scheme=scheme, linear_jump=jump, stability_limit=limit, method=case.solver,
                   tolerance=case.tolerance, snapshots=snapshots,
                   volume_factor=volume_factor, limits=g.limits, y_edges_free=g.y_edges_free,
@@ -653,9 +729,21 @@ def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0) -> t
     return setup, filled, plan
 
 
+def _worn_work(history: tuple, cycles: int) -> float:
+    """Σ Pᵢ·4δᵢ·Nᵢ over the first ``cycles`` cycles of the blocks (N·mm): times k, the worn volume."""
+    work, left = 0.0, cycles
+    for b in history:
+        n = min(b.cycles, left)
+        work += b.normal_load * 4 * b.stroke * n
+        left -= n
+        if left <= 0:
+            break
+    return work
+
+
 def loading_of(case: Case) -> Loading:
-    """The case's loading: one block today."""
-    return single(case.normal_load, case.stroke, case.cycles, case.friction_coefficient, case.tangential_stiffness)
+    """The case's loading: its blocks in the order applied (one for a constant loading)."""
+    return Loading(case.history())
 
 
 def tangential_operator(case: Case, grid: Grid):

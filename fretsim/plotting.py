@@ -56,7 +56,16 @@ def title_block(res: Results) -> str:
     name = res.attrs.get("case_name", "")
     status = "" if res.status == "complete" else f" [{res.status}]"
     parts = [f"{name}{status}"]
-    if res.inputs:
+    blocks = res.history.get("block")
+    nblocks = int(np.max(blocks)) + 1 if blocks is not None and len(blocks) else 1
+    if res.inputs and nblocks > 1:
+        parts.append(f"load history of {nblocks} blocks: P ≤ {_number(res, 'normal_load', '.4g')} N, δ ≤ "
+                     f"±{_number(res, 'stroke', '.4g')} µm, N = {_number(res, 'cycles', '.0f')}, k_m = "
+                     f"{_number(res, 'moving_wear_coefficient', '.3g')}, k_s = "
+                     f"{_number(res, 'stationary_wear_coefficient', '.3g')} 1/MPa; "
+                     f"{str(_input(res, 'dimension', '')).upper()} {_input(res, 'geometry', '')}, "
+                     f"{_input(res, 'scheme', '')}")
+    elif res.inputs:
         parts.append(f"P = {_number(res, 'normal_load', '.4g')} N, δ = ±{_number(res, 'stroke', '.4g')} µm, "
                      f"N = {_number(res, 'cycles', '.0f')}, k_m = {_number(res, 'moving_wear_coefficient', '.3g')}, "
                      f"k_s = {_number(res, 'stationary_wear_coefficient', '.3g')} 1/MPa; "
@@ -68,8 +77,15 @@ def title_block(res: Results) -> str:
            (("depth", "depth"), ("width", "width"), ("pressure", "pressure"), ("peak pressure", "max_pressure"))]
     if all(isinstance(v, float) and math.isfinite(v) for _, v in est):
         parts.append("estimated error (stepping + grid + model): "
-                     + ", ".join(f"{label} ±{v:.1%}" for label, v in est))
+                     + ", ".join(f"{label} ±{_percent(v)}" for label, v in est))
+    if res.summary.get("limit_reached"):
+        parts.append(f"wear limit {res.summary['limit_reached']} reached at N = {res.summary['cycles_to_limit']:,.0f}")
     return "\n".join(parts)
+
+
+def _percent(v: float) -> str:
+    """A relative error as a percentage with two significant figures (0.031 %, not 0.0 %)."""
+    return f"{v * 100:.2g} %"
 
 
 def _unit(res: Results, key: str) -> str:
@@ -432,7 +448,12 @@ def _history(res: Results, log_cycles: bool):
             k = _float(res, key.replace("wear_coefficient", "energy_wear_coefficient"))
             k = None if k is None else k * 1e-3  # mm³/J → mm³/(N·mm)
         work = h.get("wear_work")
-        if k is not None and work is not None and np.isfinite(work).all() and _input(res, "slip_model") == "coulomb":
+        blocks = h.get("block")
+        history = blocks is not None and len(np.unique(blocks)) > 1
+        if k is not None and work is not None and np.isfinite(work).all() and history and not energy_law:
+            ax.plot(n, k * work, color=line.get_color(), lw=0.8, alpha=0.6, ls=(0, (1, 2)),
+                    label=f"Archard Σk·P·4δ·N over the blocks, {label}")
+        elif k is not None and work is not None and np.isfinite(work).all() and _input(res, "slip_model") == "coulomb":
             ax.plot(n, k * work, color=line.get_color(), lw=0.8, alpha=0.6, ls=(0, (1, 2)),
                     label=f"{'α·ΣW' if energy_law else 'k·Σp|ds|A'}, {label}")
         elif None not in (k, load, stroke) and not energy_law:
@@ -440,6 +461,7 @@ def _history(res: Results, log_cycles: bool):
             ax.plot(n, archard, color=line.get_color(), lw=0.8, alpha=0.6, ls=(0, (1, 2)),
                     label=f"Archard k·P·4δ·N, {label}")
     ax.set_ylabel(f"wear volume ({_unit(res, 'history/wear_volume_moving')})")
+    _mark_blocks_and_limit(res, axes)
     for ax in axes:
         ax.set_xlabel("cycles N (–)")
         if log_cycles:
@@ -455,6 +477,34 @@ def _history(res: Results, log_cycles: bool):
     axes[0].set_title("maximum wear depth (a marker per contact solve)")
     axes[1].set_title("wear volume against its invariant")
     return fig
+
+
+MAX_BLOCK_LINES = 60  # beyond, the boundaries would be a grey wash: said in the legend instead
+
+
+def _mark_blocks_and_limit(res: Results, axes) -> None:
+    """A load history's block boundaries (thin vertical lines), and a wear limit reached (its cycle, and its value
+    on the axis that shows it)."""
+    h = res.history
+    blocks = h.get("block")
+    if blocks is not None and len(np.unique(blocks)) > 1:
+        ends = h["cycle"][:-1][np.diff(blocks) != 0]
+        shown = ends if len(ends) <= MAX_BLOCK_LINES else ends[:0]
+        for ax in axes:
+            for i, c in enumerate(shown):
+                ax.axvline(c, color="0.6", lw=0.6, ls="--", label="block boundaries" if i == 0 else None)
+            if len(ends) > MAX_BLOCK_LINES:
+                ax.plot([], [], " ", label=f"{len(ends) + 1} load blocks (boundaries not drawn)")
+    s = res.summary
+    key = s.get("limit_reached")
+    if key:
+        n = float(s["cycles_to_limit"])
+        for ax in axes:
+            ax.axvline(n, color="C3", lw=1.0, label=f"{key} limit reached, N = {n:,.0f}")
+        depth_limits = res.depth_limits()
+        if key.startswith("max_wear_depth") and key in depth_limits:
+            um, text = depth_limits[key]
+            axes[0].axhline(um, color="C3", lw=0.8, ls=":", label=f"limit {text}")
 
 
 def _fretting(res: Results):
@@ -512,9 +562,12 @@ SWEEP_OUTPUTS = ("centre_wear_depth_stationary_um", "max_wear_depth_moving_um", 
 
 
 def plot_sweep(table: SweepTable, outdir: str | Path, fmt: str = "png", dpi: int = 150) -> list[Path]:
-    """Response curves: each output against each swept axis, one line per combination of the other axes."""
+    """Response curves: each output against each swept axis, one line per combination of the other axes; for a
+    sampled sweep, the uncertainty figures instead (:func:`uncertainty_bands`)."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
+    if table.mode == "sample":
+        return uncertainty_bands(table, outdir, fmt, dpi)
     axes = list(table.axes)
     if not axes:
         raise ResultsFileError(f"{table.path}: the sweep has no axes (a list of points): nothing to draw curves over")
@@ -545,6 +598,93 @@ def plot_sweep(table: SweepTable, outdir: str | Path, fmt: str = "png", dpi: int
         fig.suptitle(f"{Path(table.path).name}: response to {axis}", fontsize=10)
         fig.tight_layout()
         path = outdir / f"sweep_{axis.replace('.', '_')}.{fmt}"
+        fig.savefig(path, dpi=dpi)
+        plt.close(fig)
+        paths.append(path)
+    return paths
+
+
+BAND_POINTS = 200  # cycles at which the points' histories are read for the band
+
+
+def band_data(table: SweepTable, key: str = "max_wear_depth_moving") -> dict:
+    """Per group of the listed axes: the cycles and the P10, P50 and P90 of ``key`` (a history entry) over the
+    complete points' histories, read at common cycles.  A point that stopped at its wear limit is held at its
+    last value beyond its stop (it has reached the limit: at least that deep), so the band saturates at the
+    limit as the samples reach it rather than follow only the slow ones."""
+    from fretsim.results import read_results
+    done = [r for r in table.rows if r.get("status") == "complete"]
+    groups: dict = {}
+    for r in done:
+        groups.setdefault(tuple(r.get(k) for k in table.groups), []).append(r)
+    out = {}
+    for group, rows in groups.items():
+        histories = []
+        for r in rows:
+            h = read_results(Path(table.path) / "points" / f"{r['point']}.h5").history
+            histories.append((h["cycle"].astype(float), h[key].astype(float)))
+        top = max(float(c[-1]) for c, _ in histories)
+        grid = np.linspace(0.0, top, BAND_POINTS)
+        stopped = [bool(r.get("limit_reached")) for r in rows]
+        values = np.array([np.interp(grid, c, v, right=v[-1] if held else np.nan)
+                           for (c, v), held in zip(histories, stopped)])
+        p10, p50, p90 = (np.nanpercentile(values, q, axis=0) for q in (10, 50, 90))
+        out[group] = {"cycles": grid, "p10": p10, "p50": p50, "p90": p90, "points": len(histories)}
+    return out
+
+
+def uncertainty_bands(table: SweepTable, outdir: Path, fmt: str = "png", dpi: int = 150) -> list[Path]:
+    """A sampled sweep: the deepest wear against cycles as a P10-P90 band with its median (one per group of the
+    listed axes), and a histogram of the cycles (and, with loading.frequency, years) to the wear limit."""
+    paths = []
+    bands = band_data(table, "max_wear_depth_moving")
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    for i, (group, b) in enumerate(bands.items()):
+        label = ", ".join(f"{k.split('.')[-1]} = {v}" for k, v in zip(table.groups, group)) or "all samples"
+        line, = ax.plot(b["cycles"], b["p50"], ls=STYLES[i % len(STYLES)], label=f"{label}: median")
+        ax.fill_between(b["cycles"], b["p10"], b["p90"], color=line.get_color(), alpha=0.25,
+                        label=f"{label}: P10-P90 ({b['points']} samples)")
+    ax.set_xlabel("cycles N (–)")
+    ax.set_ylabel("maximum wear depth of the moving body (µm)")
+    ax.grid(alpha=0.3)
+    ax.legend(fontsize=7)
+    ax.set_title(f"{Path(table.path).name}: depth band over the samples (a sample at its limit held there)",
+                 fontsize=9)
+    fig.tight_layout()
+    path = outdir / f"uncertainty_depth_band.{fmt}"
+    fig.savefig(path, dpi=dpi)
+    plt.close(fig)
+    paths.append(path)
+    reached = [r for r in table.rows if r.get("status") == "complete" and r.get("limit_reached")]
+    if reached:
+        years = all(r.get("time_to_limit_h") not in (None, "", "nan") for r in reached)
+        fig, ax = plt.subplots(figsize=(6.5, 4.2))
+        groups: dict = {}
+        for r in reached:
+            groups.setdefault(tuple(r.get(k) for k in table.groups), []).append(
+                float(r["time_to_limit_h"]) / 8766.0 if years else float(r["cycles_to_limit"]))
+        not_reached = [r for r in table.rows if r.get("status") == "complete" and not r.get("limit_reached")]
+        for i, (group, vals) in enumerate(groups.items()):
+            label = ", ".join(f"{k.split('.')[-1]} = {v}" for k, v in zip(table.groups, group)) or "all samples"
+            beyond = sum(1 for r in not_reached if tuple(r.get(k) for k in table.groups) == group)
+            # the samples that did not reach the limit lie beyond every one that did (percentiles.csv does so too)
+            p10, p50, p90 = np.quantile(np.r_[np.sort(vals), np.full(beyond, np.inf)], (0.1, 0.5, 0.9),
+                                        method="inverted_cdf")
+            ax.hist(vals, bins=np.logspace(np.log10(min(vals)), np.log10(max(vals)), 25) if min(vals) > 0 else 25,
+                    alpha=0.5, label=f"{label}: P10 {p10:.3g}, P50 {p50:.3g}, P90 {p90:.3g}")
+        if all(min(v) > 0 for v in groups.values()):
+            ax.set_xscale("log")
+            ax.xaxis.set_major_formatter(ScalarFormatter())
+            ax.xaxis.set_minor_formatter(plt.NullFormatter())
+        not_reached = len(not_reached)
+        ax.set_xlabel("years to the wear limit (continuous fretting)" if years else "cycles to the wear limit (–)")
+        ax.set_ylabel("samples (–)")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7)
+        ax.set_title(f"{Path(table.path).name}: {reached[0]['limit_reached']} limit"
+                     + (f" ({not_reached} samples did not reach it)" if not_reached else ""), fontsize=10)
+        fig.tight_layout()
+        path = outdir / f"uncertainty_time_to_limit.{fmt}"
         fig.savefig(path, dpi=dpi)
         plt.close(fig)
         paths.append(path)

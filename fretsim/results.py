@@ -21,8 +21,9 @@ The layout is a contract (README): names are only ever added.  Every dataset has
 and the dimension scales make ``xarray.open_dataset(path, engine="h5netcdf", group="fields")`` come out
 labelled.  Format 1.2 adds /inputs, /choices, the dimension scales, the summary datasets and the checksums to
 1.1; format 1.3 adds friction: the slip-distance and shear-traction fields, the dissipated energy and the
-invariant's work in the history, /fretting_loop, and the regime in the summary.  1.1 and 1.2 files are still
-read.
+invariant's work in the history, /fretting_loop, and the regime in the summary; format 1.4 adds load histories
+and wear limits: the block of every step in the history, and the summary's limit_reached, cycles_to_limit and
+time_to_limit_h.  1.1, 1.2 and 1.3 files are still read.
 
 Writing.  The writer keeps the run in memory and at every flush builds the whole file as an in-memory HDF5
 image, writes it with plain file I/O to a temporary file beside the target, fsyncs it and renames it over the
@@ -61,8 +62,8 @@ import numpy as np
 from fretsim import __version__
 from fretsim.errors import ResultsFileError
 
-FORMAT_VERSION = "1.3"
-READABLE_FORMATS = ("1.1", "1.2", "1.3")
+FORMAT_VERSION = "1.4"
+READABLE_FORMATS = ("1.1", "1.2", "1.3", "1.4")
 FLUSH_SECONDS = 0.5
 FLUSH_COST_FACTOR = 20.0  # flushes no more often than this many times their own cost (≤ ~5 % of the run)
 STATUSES = ("running", "complete", "interrupted", "failed", "stopped")
@@ -95,11 +96,14 @@ HISTORY = {
     "wear_work": ("N*mm", "the wear invariant's work accumulated: Σp·|ds|·A (Archard) or Σ|q|·|ds|·A (energy "
                           "law) over the cycles; each body's wear volume is its coefficient times it",
                   lambda s: s.work),
+    "block": ("1", "the loading's block (from 0, in the order applied) whose cycles led to this state",
+              lambda s: s.block),
 }
-INTEGER_HISTORY = {"cycle", "solver_iterations", "cycle_jump", "rejected_steps"}
+INTEGER_HISTORY = {"cycle", "solver_iterations", "cycle_jump", "rejected_steps", "block"}
 HISTORY_V11 = [k for k in HISTORY if not k.startswith("error_estimate") and k not in ("dissipated_energy_J",
-                                                                                        "wear_work")]
-HISTORY_V12 = [k for k in HISTORY if k not in ("dissipated_energy_J", "wear_work")]
+                                                                                        "wear_work", "block")]
+HISTORY_V12 = [k for k in HISTORY if k not in ("dissipated_energy_J", "wear_work", "block")]
+HISTORY_V13 = [k for k in HISTORY if k != "block"]
 FIELDS = {
     "wear_depth_moving": ("um", "wear depth of the moving body", lambda s: s.wear_moving * 1e3),
     "wear_depth_stationary": ("um", "wear depth of the stationary body", lambda s: s.wear_stationary * 1e3),
@@ -125,12 +129,14 @@ SUMMARY_UNITS = {
     "error_estimate_depth": "1", "error_estimate_pressure": "1", "regime": "", "tangential_force_amplitude_N": "N",
     "dissipated_energy_per_cycle_J": "J", "stick_half_width_x_mm": "mm", "gross_slip_stroke_um": "um",
     "estimated_error_depth": "1", "estimated_error_width": "1", "estimated_error_pressure": "1",
-    "estimated_error_max_pressure": "1",
+    "estimated_error_max_pressure": "1", "limit_reached": "", "cycles_to_limit": "cycles", "time_to_limit_h": "h",
+    "estimated_error_cycles_to_limit": "1",
 }
 # NaN in 2D; infinite when nothing wears; unknown without a friction coefficient
 NAN_SUMMARY = {"element_size_y_um", "stability_limit_linear", "tangential_force_amplitude_N",
                "dissipated_energy_per_cycle_J", "gross_slip_stroke_um", "estimated_error_depth", "estimated_error_width",
-               "estimated_error_pressure", "estimated_error_max_pressure"}  # not estimated: grid.error_estimate none,
+               "estimated_error_pressure", "estimated_error_max_pressure", "cycles_to_limit", "time_to_limit_h",
+               "estimated_error_cycles_to_limit"}  # not estimated: grid.error_estimate none,
 #                                                                            or a run that did not complete
 
 
@@ -589,6 +595,23 @@ class Results:
     def status(self) -> str:
         return self.attrs.get("status", "")
 
+    def depth_limits(self) -> dict:
+        """The case's wear limits on depths (key → (µm, as written)): what the history figure draws."""
+        from fretsim.units import UnitError, parse_quantity
+        from fretsim.yamlread import YamlProblem, loads
+        try:
+            limits = (loads(self.case_yaml) or {}).get("limits") or {}
+        except (YamlProblem, AttributeError):
+            return {}
+        out = {}
+        for key, text in limits.items() if isinstance(limits, dict) else ():
+            if "wear_depth" in str(key):
+                try:
+                    out[key] = (parse_quantity(text, "length") * 1e3, str(text))
+                except UnitError:
+                    continue
+        return out
+
     def published(self) -> dict:
         """source (experiment, fea, paper) → (the flat's centre-line depth µm, its scar width mm) from the case's
         `expected:` data (None where absent): what figures compare with."""
@@ -734,7 +757,8 @@ def _read(f, path: str, for_resume: bool) -> Results:
     ny, nx = y.size, x.size
     units: dict = {}
     hist_group = _group(f, "history")
-    expected = HISTORY if version >= "1.3" else HISTORY_V12 if version == "1.2" else HISTORY_V11
+    expected = (HISTORY if version >= "1.4" else HISTORY_V13 if version == "1.3" else HISTORY_V12 if version == "1.2"
+                else HISTORY_V11)
     history = {}
     for k in expected:
         history[k] = _dataset(f, f"history/{k}", 1, allow_nan=k == "dissipated_energy_J")
@@ -867,6 +891,8 @@ class SweepTable:
     axes: dict
     units: dict
     rows: list
+    mode: str = "product"
+    groups: tuple = ()  # mode sample: the listed axes (the percentiles' groups)
 
 
 def read_sweep_table(directory: str | Path) -> SweepTable:
@@ -892,4 +918,6 @@ def read_sweep_table(directory: str | Path) -> SweepTable:
             rows = list(csv.DictReader(fh))
     except (OSError, KeyError, ValueError, TypeError) as exc:
         raise ResultsFileError(f"{directory}: not a sweep's directory with a readable table ({exc})") from None
-    return SweepTable(str(directory), axes, units, rows)
+    mode = spec.get("mode", "product")
+    groups = tuple(k for k, v in spec.get("axes", {}).items() if isinstance(v, list)) if mode == "sample" else ()
+    return SweepTable(str(directory), axes, units, rows, mode, groups)

@@ -4,6 +4,7 @@ The public face of this module is :mod:`fretsim.api`; sweeps (:mod:`fretsim.swee
 """
 from __future__ import annotations
 
+import math
 import signal
 import threading
 import time
@@ -302,7 +303,7 @@ def _summary(setup, counter, t0) -> dict:
     if counter.last is None:
         return {}
     out = summarize(setup, counter.last, counter.solves, _elapsed(counter, t0), counter.errors)
-    out.update(counter.extra or {k: float("nan") for k in grid_error.KEYS})
+    out.update(counter.extra or {k: float("nan") for k in grid_error.KEYS + (grid_error.LIMIT_KEY,)})
     return out
 
 
@@ -313,7 +314,7 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
     summary = summarize(setup, counter.last, counter.solves, 0.0, counter.errors)
     model_part = sum(c.error for c in plan.choices)
     if filled.grid_error == "none" or filled.cycles == 0 or filled.elements is None:
-        return grid_error.totals(summary, None, model_part)
+        return {**grid_error.totals(summary, None, model_part), grid_error.LIMIT_KEY: float("nan")}
     line_contact = setup.y_edges_free and not setup.grid.plane_strain
     companion = grid_error.companion_case(filled, line_contact)
     try:
@@ -325,12 +326,16 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
         #                                           the coarser one: the run stands, its grid error is unknown
         counter.notes.append(f"the grid's error was not estimated: its companion run on a grid twice as coarse "
                              f"stopped ({str(exc)[:160]})")
-        return grid_error.totals(summary, None, model_part)
+        return {**grid_error.totals(summary, None, model_part), grid_error.LIMIT_KEY: float("nan")}
     coarse = summarize(c_setup, last, 0, 0.0)
     coarsest = _coarsest(filled, line_contact)
     part = grid_error.grid_estimates(summary, coarse, counter.last.pressure, setup.grid, last.pressure,
                                      c_setup.grid, coarsest)
     out = grid_error.totals(summary, part, model_part)
+    out[grid_error.LIMIT_KEY] = grid_error.cycles_to_limit_estimate(summary, coarse, counter.last.limit, model_part)
+    if counter.last.limit is not None and not math.isfinite(out[grid_error.LIMIT_KEY]):
+        counter.notes.append("the grid's part of cycles_to_limit was not estimated: the companion run on a grid "
+                             "twice as coarse reached no limit within loading.cycles")
     if not part["peak_converging"]:
         counter.notes.append(grid_error.peak_note(summary["max_pressure_MPa"], coarse["max_pressure_MPa"],
                                                   coarsest["max_pressure_MPa"], out["estimated_error_max_pressure"]))

@@ -98,6 +98,11 @@ class Setup:
     per_cycle: bool = True  # implicit schemes follow the per-cycle update (φ = h + ½r), not the continuous ODE
     gross_slip_stroke: float = float("nan")  # mm: δ_t of the unworn contact (NaN without a friction coefficient)
     notes: tuple[str, ...] = ()
+    block_cycles: tuple = ()  # a load history: the cycle model of each block of ``loading`` (empty: ``cycle``)
+    wear_limits: dict = field(default_factory=dict)  # fretsim.limits: key -> limit (internal units)
+    wall: Optional[float] = None  # mm, a tube's wall thickness (the wall_loss limit)
+    limit_tolerance: float = 1e-3  # relative: the crossing cycle of a limit is found to this
+    frequency: Optional[float] = None  # Hz: the time to a limit
 
     @property
     def solve_grid(self) -> Grid:
@@ -129,6 +134,8 @@ class Step:
     error_depth: float = 0.0  # the run's estimate of the relative depth error (accumulated)
     error_pressure: float = 0.0  # the run's estimate of the relative pressure error (L2) of this state
     work: float = 0.0  # the member's invariant accumulated to this cycle (volume = k·work), N·mm
+    block: int = 0  # the loading's block whose cycles led to this state (0 at the start)
+    limit: Optional[tuple] = None  # (key, crossing cycle, its interpolation spread): the wear limit reached here
     state: dict = field(default_factory=dict)  # the loop's checkpoint after this step (for resuming)
 
 
@@ -151,6 +158,18 @@ def _rel(v: np.ndarray, ref: np.ndarray) -> float:
     return float(np.linalg.norm(v)) / n if n > 0 else 0.0
 
 
+BLOCK_RESTART = 1 / 4  # a block's first step, as a share of the step before its start
+MAX_RETAKES = 6  # steps taken again to land on a wear limit's crossing (each lands closer: one or two suffice)
+
+
+class _Reached(Exception):
+    """A wear limit was reached at ``step``: the loop ends there."""
+
+    def __init__(self, step):
+        super().__init__("wear limit reached")
+        self.step = step
+
+
 class _Loop:
     """The loop's only mutable state: wear of both bodies, the current cycle's pressure and rates, cycle, and the
     stepping scheme's memory.
@@ -161,7 +180,7 @@ class _Loop:
     """
 
     STATE = ("n", "h_m", "h_s", "p", "r_m", "r_s", "rate_work", "work", "jump", "rejected", "elapsed", "lag", "err_abs_m",
-             "err_abs_s", "p_prev", "d_prev")
+             "err_abs_s", "p_prev", "d_prev", "block", "block_start", "work_bound", "retakes")
 
     def __init__(self, setup: Setup, observers, progress):
         self.s = setup
@@ -169,8 +188,18 @@ class _Loop:
         self.observers = observers
         self.progress = progress
         self.t0 = time.perf_counter()
-        self.stops = sorted(set(setup.snapshots) | {setup.cycles})
+        self.base_stops = sorted(set(setup.snapshots) | {setup.cycles} | set(setup.loading.boundaries))
+        self.stops = list(self.base_stops)  # and, with wear limits, the crossings a retaken step lands on
+        # block ends that are not also recorded states (snapshots, the last cycle)
+        self.boundaries = set(setup.loading.boundaries) - set(setup.snapshots) - {setup.cycles}
         self.n, self.rejected, self.elapsed = 0, 0, 0.0
+        self.block, self.block_start = 0, 0  # the block whose cycle model gives the current rates, and its start
+        self.work_bound = 0.0  # the largest wear work the blocks before the current one allow (N·mm)
+        if setup.block_cycles:
+            self.model = setup.block_cycles[0]
+        self.track: list = []  # wear limits: (cycle, {key: value}) of the last accepted steps
+        self.retakes = 0  # steps taken again to land on a limit's crossing
+        self.last_state: Optional[dict] = None
         self.h_m = np.zeros(setup.grid.shape)
         self.h_s = np.zeros(setup.grid.shape)
         self.p = self.p_prev = None
@@ -197,6 +226,11 @@ class _Loop:
         st["history_work"] = np.array([h[4] for h in self.history], dtype=float)
         st["watch"] = np.array(self.watch.history, dtype=float)
         st["scheme"] = self.s.scheme
+        if self.s.wear_limits:
+            st["limit_stops"] = np.array(sorted(set(self.stops) - set(self.base_stops)), dtype=np.int64)
+            st["track_n"] = np.array([t[0] for t in self.track], dtype=float)
+            for key in self.s.wear_limits:
+                st["track_" + key] = np.array([t[1][key] for t in self.track], dtype=float)
         for k, v in self.memory.items():
             st["memory_" + k] = v
         return st
@@ -212,6 +246,18 @@ class _Loop:
         self.err_abs_m, self.err_abs_s = float(self.err_abs_m), float(self.err_abs_s)
         self.work, self.rate_work = float(self.work), float(self.rate_work)
         self.memory = {k[len("memory_"):]: v for k, v in st.items() if k.startswith("memory_")}
+        self.block, self.block_start = int(self.block), int(self.block_start)
+        self.work_bound = float(self.work_bound)
+        if self.s.block_cycles:
+            self.model = self.s.block_cycles[self.block]
+        self.retakes = int(self.retakes)
+        self.last_state = st  # a checkpoint is the state of the step written last: a retake goes back to it
+        if self.s.wear_limits and "limit_stops" in st:
+            self.stops = sorted(set(self.base_stops) | {int(v) for v in np.atleast_1d(st["limit_stops"])})
+        if self.s.wear_limits and "track_n" in st:
+            ns = list(np.atleast_1d(st["track_n"]))
+            self.track = [(float(n), {key: float(np.atleast_1d(st["track_" + key])[i]) for key in self.s.wear_limits})
+                          for i, n in enumerate(ns)]
         flat = list(st.get("batch", []))
         works = list(np.atleast_1d(st.get("batch_work", np.zeros(len(flat) // 2))))
         self.batch = [(flat[i], flat[i + 1], float(works[i // 2])) for i in range(0, len(flat), 2)]
@@ -241,6 +287,11 @@ class _Loop:
         if extra is not None:
             op = add(op, extra)
         res = solve(op, gap, load, method=s.method, p0=guess, tol=s.tolerance)
+        if not res.success and guess is not None and s.scheme in ("bdf2", "implicit"):
+            # (not for the explicit schemes: an adaptive jump's failed solve is its rejection, retried shorter)
+            # a warm start can stall cg on a worn, conforming contact where a cold one converges (seen on the
+            # tube in service: 7247 elements, a 400 µm scar): the cold start is the fallback, not the failure
+            res = solve(op, gap, load, method=s.method, p0=None, tol=s.tolerance)
         if not res.success:
             hint = ("; the resolved stroke's worn profiles have kinks its pressure cannot follow (README): use "
                     "model.stroke: mid_stroke" if getattr(self.model, "singular_pressure", False) else "")
@@ -274,6 +325,74 @@ class _Loop:
     def next_stop(self) -> int:
         return next(t for t in self.stops if t > self.n)
 
+    def enter_block(self) -> None:
+        """At a block's start, the next block's cycle model takes over: its cycle at the current wear gives the
+        rates, and the stepping restarts as at the run's start (BDF2's history, the adaptive batch, the
+        predictor, the growth watch), since the new load or stroke changes the wear's course at once."""
+        s = self.s
+        if not s.block_cycles:
+            return
+        i = s.loading.index_at(self.n)
+        if i == self.block:
+            return
+        w_max = self.model.bounds[0]
+        self.work_bound += w_max * (self.n - self.block_start)
+        self.block, self.block_start, self.model = i, self.n, s.block_cycles[i]
+        self.memory = {}
+        # a cold start: the last block's pressure scaled to the new load made cg diverge on a worn, conforming
+        # tube contact (7247 elements, load 15 N → 5 N), where the cold start converges
+        cyc = self.cycle_at(self.n, None)
+        self.cyc = cyc
+        self.p, self.r_m, self.r_s, self.memory = cyc.pressure, cyc.rate_moving, cyc.rate_stationary, cyc.memory
+        self.rate_work = cyc.work
+        c = 0.5 if s.per_cycle else 0.0
+        self.history = [(self.n, self.h_m + c * cyc.rate_moving, self.h_s + c * cyc.rate_stationary, cyc.pressure,
+                         self.work + c * cyc.work)]
+        self.batch = [(self.h_m, self.h_s, self.work)]
+        # the wear state carries over smoothly, only its rate jumps: the steps restart well below the last one
+        # (BLOCK_RESTART of it), not at one cycle; the error control shrinks them if the new rates change fast
+        self.p_prev, self.d_prev, self.jump, self.lag = None, 1, max(1.0, self.jump * BLOCK_RESTART), 0.0
+        self.watch.reset()
+
+    def _growth_exponent(self) -> float:
+        """d ln q / d ln N of the limited quantity over the last two tracked states (1 when unknown): a relative
+        error ε in q is one of ε/exponent in the cycle at which q reaches its limit."""
+        key = self.crossing.key
+        pts = [(n, v[key]) for n, v in self.track if n > 0 and v[key] > 0]
+        if len(pts) < 2 or pts[-1][0] == pts[-2][0] or pts[-1][1] == pts[-2][1]:
+            return 1.0
+        (n0, q0), (n1, q1) = pts[-2:]
+        return float(np.log(q1 / q0) / np.log(n1 / n0))
+
+    def _limit_check(self, step: Step) -> Optional[str]:
+        """Wear limits at a new step: None to go on; "retake" when a limit was passed within a step too long to
+        place the crossing (the state is rolled back to the previous step, with a stop at the estimated
+        crossing); "reached" when the crossing is placed (``self.crossing``)."""
+        from fretsim import limits
+        s = self.s
+        values = {k: limits.value(k, step, s.grid, s.wall) for k in s.wear_limits}
+        points = self.track + [(float(self.n), values)]
+        found = limits.first(s.wear_limits, {k: [(n, v[k]) for n, v in points] for k in s.wear_limits})
+        if found is None:
+            self.track = points[-3:]
+            return None
+        before = points[-2][0] if len(points) > 1 else 0.0
+        tolerance = max(1.0, s.limit_tolerance * found.cycle)
+        # half the tolerance past the estimated crossing: the landing then passes it for certain (an estimate a
+        # few cycles short would leave the landing just below the limit, and the next step far past it again)
+        target = int(np.ceil(found.cycle + 0.5 * (tolerance - 1.0)))
+        # taken again unless it ends at the crossing (within the tolerance): the state at the limit is the one
+        # reported, and a crossing placed from a step that ends there is interpolated over the least
+        if (self.n - found.cycle > tolerance and self.n - before > 1 and self.retakes < MAX_RETAKES and
+                self.last_state is not None and before < target < self.n):
+            retakes = self.retakes + 1
+            self.restore(self.last_state)
+            self.retakes = retakes  # after the restore, which would count it back
+            self.stops = sorted(set(self.stops) | {target})
+            return "retake"
+        self.crossing = found
+        return "reached"
+
     def emit(self, cyc: Cycle, jump: int, error_pressure: float = 0.0) -> Step:
         s = self.s
         self.cyc = cyc
@@ -287,7 +406,8 @@ class _Loop:
         if step.archard_error > ARCHARD_ROUND_OFF:
             raise NumericalFailure(f"the wear invariant is broken at cycle {self.n}: the wear volume differs from "
                                    f"{self.model.invariant} by {step.archard_error:.2e} (relative)", self.n)
-        _check_bounds(self.model, cyc, self.work, self.n)
+        _check_bounds(self.model, cyc, self.work, self.n,
+                      self.work_bound + self.model.bounds[0] * (self.n - self.block_start))
         if self.n > 0 and self.watch.update(step.checkerboard) and s.watch_growth:
             if s.scheme in ("linear", "adaptive"):
                 cause = (f"the {'linear jump ' + str(s.linear_jump) + ' cycles' if s.scheme == 'linear' else 'adaptive jumps'}"
@@ -305,11 +425,21 @@ class _Loop:
             raise NumericalFailure(
                 f"the pressure checkerboards at cycle {self.n}: an odd-even pattern grew over the last steps "
                 f"(amplitude {abs(step.checkerboard):.1%} of the mean pressure); {cause}", self.n)
+        step.block = self.block
+        verdict = self._limit_check(step) if s.wear_limits and self.n > 0 else None
+        if verdict == "retake":
+            return None
+        if verdict == "reached":
+            step.is_snapshot = True  # the state at the limit is what the engineer looks at
+            step.limit = (self.crossing.key, self.crossing.cycle, self.crossing.spread, self._growth_exponent())
         step.state = self.state()
+        self.last_state = step.state
         for obs in self.observers:
             obs.on_step(s, step)
         if self.progress is not None and jump:
             self.progress(jump)
+        if verdict == "reached":
+            raise _Reached(step)
         self._check_body(self.p)
         return step
 
@@ -371,9 +501,12 @@ class _Loop:
                 return self.current_step()
         if s.cycles == 0 or self.n >= s.cycles:
             return step
-        if s.scheme in ("bdf2", "implicit"):
-            return self._implicit(2 if s.scheme == "bdf2" else 1) or step
-        return {"linear": self._linear, "adaptive": self._adaptive}[s.scheme]() or step
+        try:
+            if s.scheme in ("bdf2", "implicit"):
+                return self._implicit(2 if s.scheme == "bdf2" else 1) or step
+            return {"linear": self._linear, "adaptive": self._adaptive}[s.scheme]() or step
+        except _Reached as reached:
+            return reached.step
 
     # -- explicit schemes (the paper's) ---------------------------------------------------------------------
     def _explicit_step(self, d_n) -> tuple[Cycle, float]:
@@ -393,9 +526,10 @@ class _Loop:
     def _linear(self) -> Step:
         step = None
         while self.n < self.s.cycles:
+            self.enter_block()
             d_n = min(self.s.linear_jump, self.next_stop() - self.n)
             cyc, e_p = self._explicit_step(d_n)
-            step = self.emit(cyc, d_n, e_p)
+            step = self.emit(cyc, d_n, e_p) or step
         return step
 
     def _adaptive(self) -> Step:
@@ -414,6 +548,7 @@ class _Loop:
         if not self.batch:
             self.batch = [(self.h_m, self.h_s, self.work)]
         while self.n < s.cycles:
+            self.enter_block()
             room = self.next_stop() - self.n
             if len(self.batch) > Q_LINEAR and room > (Q_LINEAR + 1) * lin:
                 (m2, s2, w2), (m1, s1, w1), (m0, s0, w0) = self.batch[-3:]
@@ -442,7 +577,7 @@ class _Loop:
                     self.p_prev = None
                     self.batch = [(self.h_m, self.h_s, self.work)]
                     self.watch.reset()  # a jump is not a step of the linear sequence whose growth is watched
-                    step = self.emit(cyc, jump, 0.5 * _rel(cyc.pressure - self.p, cyc.pressure))
+                    step = self.emit(cyc, jump, 0.5 * _rel(cyc.pressure - self.p, cyc.pressure)) or step
                     break
                 else:
                     self.batch = [(self.h_m, self.h_s, self.work)]
@@ -453,7 +588,7 @@ class _Loop:
             # a shortened step breaks the equal spacing the differences need: restart the batch
             here = (self.h_m, self.h_s, self.work)
             self.batch = self.batch + [here] if d_n == lin else [here]
-            step = self.emit(cyc, d_n, e_p)
+            step = self.emit(cyc, d_n, e_p) or step
         return step
 
     # -- implicit schemes: backward Euler (order 1) and variable-step BDF2 (order 2) --------------------------
@@ -480,6 +615,8 @@ class _Loop:
         # relax: within the landing zone cover at most THETA_LANDING of the rest, unless the rest is cheap
         small = self.s.step_tolerance / self.lag if self.lag > 0 else np.inf
         d_land = max(np.ceil(THETA_LANDING * rem), np.floor(small))
+        if self.next_stop() in self.boundaries:  # a block's end is not a recorded state: no pressure to land
+            d_land = rem
         free = int(max(1, min(d, rem)))
         d = int(max(1, min(d, rem, d_land)))
         return d, d < free or d < self.jump
@@ -510,8 +647,9 @@ class _Loop:
         retries = 0
         tol = s.step_tolerance
         while self.n < s.cycles:
+            self.enter_block()
             if self.n < EXACT_CYCLES and s.stability_limit > 2.0:
-                step = self._exact_cycle()
+                step = self._exact_cycle() or step
                 continue
             d, constrained = self._step_size(order)
             n_now, phi_m, phi_s, p_now, phi_w = self.history[-1]
@@ -573,7 +711,7 @@ class _Loop:
                 self.jump = next_step(d, error, tol, k_order)
                 continue
             e_p = 0.5 * _rel(p_new - p_now, p_new)
-            if self.n + d == self.next_stop() and e_p > tol and d > 1:
+            if self.n + d == self.next_stop() and e_p > tol and d > 1 and self.n + d not in self.boundaries:
                 # landing on a recorded state with a pressure lag beyond the tolerance: taper instead
                 self.rejected += 1
                 self.lag = max(self.lag, e_p / d)
@@ -586,7 +724,7 @@ class _Loop:
             self.history = (self.history + [(self.n, new_phi_m, new_phi_s, p_new, new_phi_w)])[-HISTORY_POINTS:]
             proposal = next_step(d, error, tol, k_order)
             self.jump = max(self.jump, proposal) if constrained else proposal
-            step = self.emit(cyc, d, e_p)
+            step = self.emit(cyc, d, e_p) or step
         return step
 
 
@@ -640,8 +778,9 @@ BOUND_ROUND_OFF = 1e-6  # the tangential solve's slip is exact to ~1e-10 of the 
 #                         bound by more than this is a fault, not round-off
 
 
-def _check_bounds(model, cyc: Cycle, work: float, cycle: int) -> None:
-    """The cycle's work and energy, and the work accumulated to ``cycle``, within what the physics allows."""
+def _check_bounds(model, cyc: Cycle, work: float, cycle: int, work_max: Optional[float] = None) -> None:
+    """The cycle's work and energy, and the work accumulated to ``cycle`` (at most ``work_max``: the blocks' bounds
+    times their cycles so far), within what the physics allows."""
     w_max, e_max = model.bounds
     top = 1.0 + BOUND_ROUND_OFF
     what = None
@@ -650,10 +789,29 @@ def _check_bounds(model, cyc: Cycle, work: float, cycle: int) -> None:
                f"than the rig travels, 4δ)"
     elif np.isfinite(cyc.energy) and not (0.0 <= cyc.energy <= e_max * top):
         what = f"the dissipated energy per cycle {cyc.energy:.6g} N·mm lies outside [0, μ·P·4δ = {e_max:.6g}]"
-    elif not (0.0 <= work <= w_max * max(cycle, 1) * top):
-        what = f"the accumulated wear work {work:.6g} N·mm lies outside [0, {w_max * cycle:.6g}] ({cycle} cycles)"
+    elif not (0.0 <= work <= (w_max * max(cycle, 1) if work_max is None else max(work_max, w_max)) * top):
+        bound = w_max * cycle if work_max is None else work_max
+        what = f"the accumulated wear work {work:.6g} N·mm lies outside [0, {bound:.6g}] ({cycle} cycles)"
     if what:
         raise NumericalFailure(f"a physical bound is broken at cycle {cycle}: {what}", cycle)
+
+
+def _expected_volumes(setup: Setup, cycle: int, work: float) -> tuple[float, float]:
+    """The invariant's volumes after ``cycle`` cycles: a closed-form member's summed over the blocks so far
+    (Σ kᵢ·Pᵢ·4δᵢ·Nᵢ), any other's from the accumulated work."""
+    if not setup.block_cycles or not getattr(setup.cycle, "closed_form", False):
+        return setup.cycle.expected_volumes(cycle, work)
+    moving = stationary = 0.0
+    start = 0
+    for block, model in zip(setup.loading.blocks, setup.block_cycles):
+        n = min(max(cycle - start, 0), block.cycles)
+        start += block.cycles
+        if n:
+            v_m, v_s = model.expected_volumes(n, 0.0)
+            moving, stationary = moving + v_m, stationary + v_s
+        if start >= cycle:
+            break
+    return moving, stationary
 
 
 def _record(setup: Setup, cycle: int, h_m, h_s, cyc: Cycle, work: float, t0) -> Step:
@@ -662,7 +820,7 @@ def _record(setup: Setup, cycle: int, h_m, h_s, cyc: Cycle, work: float, t0) -> 
     v_s = float(h_s.sum()) * area
     err = 0.0
     if cycle > 0:
-        expect_m, expect_s = setup.cycle.expected_volumes(cycle, work)
+        expect_m, expect_s = _expected_volumes(setup, cycle, work)
         err = max(abs(v_m / expect_m - 1) if expect_m else abs(v_m),
                   abs(v_s / expect_s - 1) if expect_s else abs(v_s))
     res = cyc.contact
@@ -733,4 +891,9 @@ def summarize(setup: Setup, step: Step, solves: int, wall_time: float, max_error
         "dissipated_energy_per_cycle_J": float(step.cycle_result.energy) * 1e-3,
         "stick_half_width_x_mm": float(step.cycle_result.stick_half_width_x),
         "gross_slip_stroke_um": float(setup.gross_slip_stroke) * 1e3,
+        # wear limits: the first reached ("" if none) and the interpolated cycle (NaN if none was reached)
+        "limit_reached": step.limit[0] if step.limit else "",
+        "cycles_to_limit": float(step.limit[1]) if step.limit else float("nan"),
+        "time_to_limit_h": (float(step.limit[1]) / setup.frequency / 3600.0 if step.limit and setup.frequency
+                            else float("nan")),
     }

@@ -55,14 +55,15 @@ def _odd(n: float) -> int:
 
 def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float, cycles: int, k_total: float,
               e_star: float, strokes: int = 1, refine: float = 1.0, accuracy: Optional[float] = None,
-              pressure_accuracy: Optional[float] = None) -> Sizing:
+              pressure_accuracy: Optional[float] = None, volume: Optional[float] = None) -> Sizing:
     """The paper's element size and a domain holding the estimated final scar (both bodies' volume), plus
     ``strokes`` stroke amplitudes along x (the flat's wear reaches one stroke beyond the contact; seen through
     the stroke average, two).  Given ``accuracy``, the element along x is also at most accuracy/WIDTH_SHARE of
     the estimated scar width (at most MAX_ACCURACY_REFINEMENT times finer than the paper's)."""
     h = geometry.hertz(load, e_star)
     a = h.half_width_x
-    volume = k_total * load * 4 * stroke * cycles
+    if volume is None:  # both bodies' worn volume (a load history gives its own sum over the blocks)
+        volume = k_total * load * 4 * stroke * cycles
     scar_x, scar_y = geometry.scar_half_widths(volume)
     # no contact is wider than the body: beyond that the run stops at the physical limit
     limits = geometry.limits

@@ -38,10 +38,10 @@ from fretsim.case import CaseError, parse_case
 from fretsim.units import UNITS, UnitError, parse_quantity
 from fretsim.yamlread import YamlProblem, excerpt, loads, read_text
 
-MODES = ("product", "zip", "points")
+MODES = ("product", "zip", "points", "sample")
 MAX_POINTS = 100_000
 DASK_CONNECT_TIMEOUT = "10s"  # a scheduler that does not answer within this is reported, not waited on
-KEYS = {"base", "set", "mode", "axes", "points"}
+KEYS = {"base", "set", "mode", "axes", "points", "sample"}
 
 
 @dataclass(frozen=True)
@@ -61,12 +61,18 @@ class Sweep:
     mode: str
     axes: dict  # key → list of values (product, zip)
     points: list = field(default_factory=list)
+    sample: Optional[dict] = None  # mode sample: {n, seed}; the distributed axes are in ``axes`` as mappings
+
+    @property
+    def groups(self) -> list:
+        """Mode sample: the listed (not distributed) axes, whose values group the percentiles."""
+        return [k for k, v in self.axes.items() if isinstance(v, list)] if self.mode == "sample" else []
 
     def spec(self) -> dict:
         """What defines the sweep (stored beside its results: a changed sweep gets its own new points)."""
         return {"base": self.base_source, "set": list(self.shared), "mode": self.mode,
-                "axes": {k: [str(v) for v in vs] for k, vs in self.axes.items()},
-                "points": [p.name for p in self.points]}
+                "axes": {k: ([str(v) for v in vs] if isinstance(vs, list) else vs) for k, vs in self.axes.items()},
+                "points": [p.name for p in self.points], **({"sample": self.sample} if self.sample else {})}
 
 
 def _text(v) -> str:
@@ -117,7 +123,10 @@ def load_sweep(path: str | Path, progress: Optional[Callable[[int, int], None]] 
     if not isinstance(shared, list) or not all(isinstance(s, str) and "=" in s for s in shared):
         problems.append(("set", "expected a list of key.path=value overrides, e.g. [model.dimension=2d]"))
         shared = []
-    mode = raw.get("mode", "points" if "points" in raw and "axes" not in raw else "product")
+    mode = raw.get("mode", "sample" if "sample" in raw else "points" if "points" in raw and "axes" not in raw
+                   else "product")
+    if "sample" in raw and mode != "sample":
+        problems.append(("mode", f"{excerpt(mode)} with sample:; a sampled sweep is mode sample (or leave mode out)"))
     if mode not in MODES:
         problems.append(("mode", f"unknown value {excerpt(mode)}; expected one of {', '.join(MODES)}"))
     axes = raw.get("axes", {}) if mode != "points" else {}
@@ -143,6 +152,39 @@ def load_sweep(path: str | Path, progress: Optional[Callable[[int, int], None]] 
             keys = list(good)
             combos = product(*good.values()) if mode == "product" else zip(*good.values())
             points = [dict(zip(keys, c)) for c in combos]
+    elif mode == "sample":
+        from fretsim import uncertainty
+        spec = raw.get("sample")
+        n = spec.get("n") if isinstance(spec, dict) else None
+        seed = spec.get("seed", 1) if isinstance(spec, dict) else None
+        if not isinstance(spec, dict) or set(spec) - {"n", "seed"} or not isinstance(n, int) or isinstance(n, bool) \
+                or not 1 <= n <= MAX_POINTS or not isinstance(seed, int) or isinstance(seed, bool):
+            problems.append(("sample", f"expected {{n: number of samples (1 to {MAX_POINTS}), seed: a whole number}}, "
+                                       f"got {excerpt(spec)}"))
+            n, seed = 0, 0
+        if not isinstance(axes, dict) or not axes:
+            problems.append(("axes", "expected a mapping of case keys to distributions (or lists of values)"))
+            axes = {}
+        dists, lists = {}, {}
+        for k, v in axes.items():
+            if isinstance(v, list) and v:
+                lists[k] = v
+                continue
+            why = uncertainty.check(v)
+            if why:
+                problems.append((f"axes.{k}", why))
+            else:
+                dists[k] = v
+        if not dists and not problems:
+            problems.append(("axes", "a sampled sweep needs at least one axis that is a distribution"))
+        count = n
+        for vs in lists.values():
+            count *= len(vs)
+        if count > MAX_POINTS:
+            problems.append(("sample", f"{count} points; at most {MAX_POINTS}"))
+        elif not problems:
+            draws = uncertainty.sample(dists, n, seed)
+            points = [{**dict(zip(lists, combo)), **d} for combo in product(*lists.values()) for d in draws]
     elif mode == "points":
         listed = raw.get("points")
         if not isinstance(listed, list) or not listed or not all(isinstance(p, dict) and p for p in listed):
@@ -151,7 +193,8 @@ def load_sweep(path: str | Path, progress: Optional[Callable[[int, int], None]] 
             problems.append(("points", f"{len(listed)} points; at most {MAX_POINTS}"))
         else:
             points = listed
-    sweep = Sweep(source, base_text, base_source, tuple(shared), mode, axes if isinstance(axes, dict) else {})
+    sweep = Sweep(source, base_text, base_source, tuple(shared), mode, axes if isinstance(axes, dict) else {},
+                  sample=raw.get("sample") if mode == "sample" else None)
     names = set()
     for i, values in enumerate(points):
         if progress is not None and i % 1000 == 0 and len(points) > 1000:
@@ -520,24 +563,12 @@ def _numeric_axis(values: list):
 
 
 def write_table(sweep: Sweep, rows: list, outdir: Path) -> tuple[Path, Path]:
-    import csv
-
     import h5py
     import numpy as np
 
     from fretsim.results import SUMMARY_UNITS
     csv_path, h5_path = outdir / "table.csv", outdir / "table.h5"
-    keys = list(dict.fromkeys(k for r in rows for k in r))
-    tmp = outdir / ".table.csv.part"
-    try:
-        with open(tmp, "w", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=keys)
-            w.writeheader()
-            w.writerows(rows)
-        os.replace(tmp, csv_path)
-    finally:
-        if tmp.is_file():  # a failed write leaves no temporary behind
-            tmp.unlink()
+    _write_csv(csv_path, list(dict.fromkeys(k for r in rows for k in r)), rows)
     outputs = [k for k in SUMMARY_UNITS if any(k in r for r in rows)]
     tmp = outdir / ".table.h5.part"
     with h5py.File(tmp, "w") as f:
@@ -568,7 +599,7 @@ def write_table(sweep: Sweep, rows: list, outdir: Path) -> tuple[Path, Path]:
                 c.attrs["units"] = units or ""
                 c.dims[0].attach_scale(ds)
         coords = " ".join(k for k in f if k not in ("point",)) if sweep.mode != "product" else ""
-        texts = {"status", "regime"}  # the summary's words; every other output is a number
+        texts = {"status", "regime", "limit_reached"}  # the summary's words; every other output is a number
         for name, data, dtype in ([("status", [r["status"] for r in rows], text)] +
                                   [(k, [r.get(k, "" if k in texts else float("nan")) for r in rows],
                                     text if k in texts else float) for k in outputs]):
@@ -580,4 +611,32 @@ def write_table(sweep: Sweep, rows: list, outdir: Path) -> tuple[Path, Path]:
             if coords:
                 ds.attrs["coordinates"] = coords
     os.replace(tmp, h5_path)
+    if sweep.mode == "sample":
+        write_percentiles(sweep, rows, outdir)
     return csv_path, h5_path
+
+
+def write_percentiles(sweep: Sweep, rows: list, outdir: Path) -> Path:
+    """DIR/percentiles.csv: P10, P50 and P90 of every summary value over the complete points (per group of the
+    listed axes), with its unit."""
+    from fretsim.results import SUMMARY_UNITS
+    from fretsim.uncertainty import percentiles
+    table = percentiles(rows, sweep.groups, {k: u for k, u in SUMMARY_UNITS.items() if u != ""})
+    path = outdir / "percentiles.csv"
+    _write_csv(path, [*sweep.groups, "key", "p10", "p50", "p90", "unit", "points", "missing", "not_complete"], table)
+    return path
+
+
+def _write_csv(path: Path, fields: list, rows: list) -> None:
+    """A CSV written whole or not at all (a temporary beside it, renamed over it)."""
+    import csv
+    tmp = path.with_name(f".{path.name}.part")
+    try:
+        with open(tmp, "w", newline="") as fh:
+            w = csv.DictWriter(fh, fieldnames=fields)
+            w.writeheader()
+            w.writerows(rows)
+        os.replace(tmp, path)
+    finally:
+        if tmp.is_file():  # a failed write leaves no temporary behind
+            tmp.unlink()

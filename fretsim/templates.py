@@ -8,14 +8,15 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from fretsim.case import GEOMETRY_KEYS, REQUIRED, SCHEMA, Key
+from fretsim.case import LIMITS_SCHEMA, GEOMETRY_KEYS, REQUIRED, SCHEMA, Key
 from fretsim.units import INTERNAL
 
 CASES = Path(__file__).resolve().parent / "cases"
 SECTION_HELP = {
     "geometry": "the contact geometry; x is the sliding direction, y across it; the moving body slides",
     "material": "each of materials.moving and materials.stationary",
-    "loading": "the load, the slip and the length of the test",
+    "loading": "the load, the slip and the length of the test (or a load history: loading.blocks or "
+               "loading.spectrum, `fretsim case-reference`)",
     "model": "what physics to include; `auto` picks the cheapest model within model.accuracy, and says why",
     "solver": "the normal-contact solver",
     "jumping": "how the cycles are stepped through",
@@ -37,9 +38,10 @@ def _unit(spec: Key) -> str:
     if spec.kind in INTERNAL:
         return {"length": "m, mm, um (µm), nm", "force": "N, kN, mN", "pressure": "Pa … GPa",
                 "wear_coefficient": "1/MPa, mm3/(N·m), 1/Pa, mm2/N, m2/N", "energy_wear_coefficient": "mm3/J, um3/J, m3/J",
-                "stiffness": "N/mm, N/um, kN/mm, N/m"}[spec.kind]
+                "stiffness": "N/mm, N/um, kN/mm, N/m", "frequency": "Hz, kHz, 1/min",
+                "volume": "mm3, um3, m3"}[spec.kind]
     return {"fraction": "% or a fraction", "integer": "–", "number": "–", "choice": "–", "lengths": "lengths",
-            "counts": "–", "cycle_list": "cycles"}.get(spec.kind, "–")
+            "counts": "–", "cycle_list": "cycles", "blocks": "a list"}.get(spec.kind, "–")
 
 
 def _default(spec: Key) -> str:
@@ -82,6 +84,13 @@ def case_reference_markdown() -> str:
                 for key, spec in gkeys.items():
                     lines.append(f"| `geometry.{key}` ({kind}) | {_unit(spec)} | {_default(spec)} | "
                                  f"{_allowed(spec)} | {spec.help} |")
+    lines += ["| `loading.blocks[i]` / `loading.spectrum[i]` | – | – | a mapping | normal_load, stroke and cycles "
+              "(blocks) or fraction (spectrum, of loading.cycles), and friction_coefficient where it differs; "
+              "with blocks, loading.normal_load and loading.stroke are not given |"]
+    for key, spec in LIMITS_SCHEMA.items():
+        lines.append(f"| `limits.{key}` | {_unit(spec)} | {_default(spec)} | {_allowed(spec)} | a wear limit: "
+                     f"{spec.help}; the run stops where the first limit is reached and reports limit_reached, "
+                     f"cycles_to_limit (and time_to_limit_h with loading.frequency) |")
     lines += ["| `expected` | – | – | a mapping | published values kept beside the inputs (experiment, FEA, the "
               "paper), read by `fretsim validate`, never run |", ""]
     return "\n".join(lines)
@@ -113,7 +122,11 @@ def template_text(kind: str) -> str:
                     example = "1 N"
                 out.append(f"  {key + ': ' + example:<29} # {spec.help}")
             else:
+                if spec.kind == "blocks" or key == "repeat":
+                    continue  # a load history replaces normal_load, stroke and cycles: the section's note says so
                 shown = "auto" if spec.default is None else spec.default
+                if spec.default is None and "omitted:" in spec.help and spec.example:
+                    shown = spec.example  # an opt-in: what a value looks like
                 if spec.default is None and spec.choices and "auto" not in spec.choices:
                     shown = spec.choices[0]  # `auto` is not one of its values: show one that is
                 out.append(f"  # {key + ': ' + str(shown):<27} # {spec.help}")

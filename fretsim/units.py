@@ -26,10 +26,12 @@ UNITS: dict[str, dict[str, float]] = {
     # worn volume per dissipated energy (Fouvry's α): 1 J = 1000 N·mm
     "energy_wear_coefficient": {"mm3/J": 1e-3, "mm^3/J": 1e-3, "um3/J": 1e-12, "µm3/J": 1e-12, "µm^3/J": 1e-12,
                                 "m3/J": 1e6, "m^3/J": 1e6, "mm3/Nm": 1e-3, "mm3/(N*m)": 1e-3, "mm3/(N*mm)": 1.0},
+    "frequency": {"Hz": 1.0, "kHz": 1e3, "1/s": 1.0, "1/min": 1.0 / 60, "cpm": 1.0 / 60},
+    "volume": {"mm3": 1.0, "mm^3": 1.0, "um3": 1e-9, "µm3": 1e-9, "m3": 1e9, "cm3": 1e3},
     "stiffness": {"N/mm": 1.0, "N/um": 1e3, "N/µm": 1e3, "kN/mm": 1e3, "N/m": 1e-3, "kN/m": 1.0, "MN/m": 1e3},
 }
 INTERNAL = {"length": "mm", "force": "N", "pressure": "MPa", "wear_coefficient": "1/MPa",
-            "energy_wear_coefficient": "mm3/(N*mm)", "stiffness": "N/mm"}
+            "energy_wear_coefficient": "mm3/(N*mm)", "stiffness": "N/mm", "frequency": "Hz", "volume": "mm3"}
 
 _QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf|nan)\s*(\S.*?)\s*$", re.IGNORECASE)
 _TYPESET = str.maketrans({"·": "*", "⋅": "*", "×": "*", "³": "3", "²": "2", "^": None})
@@ -104,7 +106,8 @@ def _short(value: object) -> str:
 
 def example(dimension: str) -> str:
     return {"length": "25 um", "force": "185 N", "pressure": "200 GPa", "wear_coefficient": "2.0e-8 1/MPa",
-            "energy_wear_coefficient": "2.5e-5 mm3/J", "stiffness": "40 N/um"}[dimension]
+            "energy_wear_coefficient": "2.5e-5 mm3/J", "stiffness": "40 N/um", "frequency": "30 Hz",
+            "volume": "0.01 mm3"}[dimension]
 
 
 def format_quantity(value: float, dimension: str) -> str:

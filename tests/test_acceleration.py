@@ -20,6 +20,12 @@ CASES = Path(__file__).resolve().parent.parent / "cases"
 SHIPPED = sorted(p.stem for p in CASES.glob("*.yaml") if load_case(p).cycles > 0)
 # point contacts have no 2D model, so they get short 3D runs
 POINT = {name for name in SHIPPED if not load_case(CASES / f"{name}.yaml").geometry.has_2d}
+# service cases stop at a wear limit, their loading.cycles only an upper bound (10⁹-10¹⁰): where a test takes a
+# body's wear away the limit is never reached, so these tests take their first LIMITED_CYCLES cycles.  (Without
+# the tube's wear the flat's groove fits the tube ever closer and cg slows: 2·10⁷ cycles took 668 solves and 170 s;
+# tests/test_service_life.py covers the blocks and the limits.)
+LIMITED = {name for name in SHIPPED if load_case(CASES / f"{name}.yaml").limits}
+LIMITED_CYCLES = 2_000_000
 
 
 def quick(name: str, cycles: int) -> list[str]:
@@ -97,6 +103,7 @@ def test_bdf2_is_more_accurate_than_backward_euler_at_a_third_of_the_tolerance_w
 @pytest.mark.parametrize("name", SHIPPED)
 def test_either_body_with_a_zero_wear_coefficient_completes_with_the_default_scheme(name, body):
     cycles = load_case(CASES / f"{name}.yaml").cycles
+    cycles = min(cycles, LIMITED_CYCLES) if name in LIMITED else cycles
     out = run(load_case(CASES / f"{name}.yaml", [*quick(name, cycles), f"materials.{body}.wear_coefficient=0 1/MPa"]))
     assert out.status == "complete", out.message
     assert out.summary["archard_volume_error"] < 1e-9
@@ -125,13 +132,19 @@ def test_linear_jumps_below_the_computed_limit_complete(name, fraction):
     case = load_case(CASES / f"{name}.yaml", quick(name, 4000))
     limit = prepare(case)[0].stability_limit
     jump = max(1, int(fraction * limit))
-    out = run(load_case(CASES / f"{name}.yaml", [*quick(name, 4000), "jumping.scheme=linear", f"jumping.linear={jump}"]))
+    linear = [*quick(name, 4000), "jumping.scheme=linear", f"jumping.linear={jump}"]
+    if limit < 1:  # no whole cycle is below the limit (the 90 °C tube in service, 80 µm stroke): refused, said so
+        with pytest.raises(CaseError, match="exceeds the explicit stability limit"):
+            run(load_case(CASES / f"{name}.yaml", linear))
+        return
+    out = run(load_case(CASES / f"{name}.yaml", linear))
     assert out.status == "complete", out.message
 
 
 @pytest.mark.slow
 @pytest.mark.parametrize("fraction", [0.5, 0.9, 0.99])
-@pytest.mark.parametrize("name", SHIPPED)
+@pytest.mark.parametrize("name", sorted(set(SHIPPED) - LIMITED))  # a service case's 10⁹ cycles in linear jumps of
+#                                                                    a few hundred would be millions of solves
 def test_linear_jumps_below_the_computed_limit_complete_whole_cases(name, fraction):
     dim = [] if name in POINT else ["model.dimension=2d"]
     limit = prepare(load_case(CASES / f"{name}.yaml", dim))[0].stability_limit

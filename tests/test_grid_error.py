@@ -130,10 +130,14 @@ def test_without_the_companion_the_totals_are_not_given_and_the_text_says_so(tmp
 
 
 SHIPPED = sorted(p.stem for p in CASES.glob("*.yaml"))
+# not the service cases: their fullest model (3D, ring bending, free faces, 7243 × 27 elements) over 10⁹ cycles is
+# beyond this suite's budget, and at a wear limit the limited depth is pinned (the comparison would be of
+# cycles_to_limit); their tube's 2D-against-3D choice is the shipped tube_RT's, which is checked here
+UNLIMITED = [n for n in SHIPPED if not load_case(CASES / f"{n}.yaml").limits]
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize("name", SHIPPED)
+@pytest.mark.parametrize("name", UNLIMITED)
 def test_auto_keeps_its_promise_against_the_fullest_model_at_full_resolution(name):
     """Both keys on auto, against the fullest model (3D with every correction that applies) on the default grid:
     each reported depth and width within model.accuracy.  auto accepts a simpler model only where three times

@@ -79,6 +79,8 @@ class UniformCycle:
         return self.total_load * 4.0 * self.stroke, (mu * self.total_load * 4.0 * self.stroke if mu is not None
                                                       else float("inf"))
 
+    closed_form = True  # its invariant is k·P·4δ·N itself (summed over a load history's blocks)
+
     def expected_volumes(self, cycles: int, work: float) -> tuple[float, float]:
         # closed form, not the accumulated work: the paper's invariant exactly
         return (archard_volume(self.k_moving, self.total_load, cycles, self.stroke),

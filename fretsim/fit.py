@@ -1,0 +1,337 @@
+"""Case values fitted to measured wear: bounded least squares over runs of the case.
+
+Wear coefficients scatter by a factor of two or more between tests and are themselves fitted to tests.  Given a
+case and measurements at given cycles (a CSV laid out like the history ``fretsim export`` writes:
+``cycle [cycles],max_wear_depth_stationary [um],…``; any of the wear-limit quantities of :mod:`fretsim.limits`,
+or whole profiles: ``cycle [cycles],x [mm],wear_depth_stationary [um]``), the chosen case values (both wear
+coefficients by default) are found that make the runs reproduce them best.
+
+The residuals are relative (model/measured − 1; a profile's against its deepest measured point), so depths,
+widths and volumes weigh alike.  Positive values are fitted in logarithms (a wear coefficient is known to a
+factor, not to a difference), within a factor of 1000 of the case's value.  The confidence intervals are the
+usual linearised ones: the Jacobian at the optimum, the residuals' variance over the degrees of freedom, and
+Student's t at 95 %; with as many values as data there are none, and the result says so.  The runs use the
+case's stepping at a tolerance of at most 1e-3, so that the finite differences (5 % in each value) are not
+stepping noise, on one grid and with one model throughout (those the case chooses at its starting values; the
+flat's wear through the stroke-averaged gap unless the case names one, since the paper's mid-stroke gap is
+unstable for some coefficients a search may try).
+"""
+from __future__ import annotations
+
+import csv
+import math
+import re
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Callable, Optional
+
+import numpy as np
+
+from fretsim.case import LIMITS_SCHEMA, SCHEMA, Case, CaseError, Key, parse_case
+from fretsim.limits import LIMIT_KEYS
+from fretsim.simulate import SimulationError
+from fretsim.units import UnitError, format_quantity, parse_quantity
+
+DEFAULT_FIT = ("materials.moving.wear_coefficient", "materials.stationary.wear_coefficient")
+PROFILES = {"wear_depth_moving": "moving", "wear_depth_stationary": "stationary"}
+FIT_TOLERANCE = 1e-3  # jumping.tolerance of the fit's runs, at most
+DIFF_STEP = 0.05  # the finite differences' step in ln(value)
+RANGE = 1000.0  # a value is sought within this factor of the case's
+_HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[\s*([^\]]*)\s*\])?\s*$")
+
+
+@dataclass
+class Measured:
+    source: str
+    cycles: np.ndarray  # per datum
+    keys: list  # per datum: a limit quantity, or a profile name
+    values: np.ndarray  # per datum, internal units
+    x: np.ndarray  # per datum: the profile's x (mm), NaN for a scalar
+    units: dict = field(default_factory=dict)  # column → unit as written
+
+
+def _spec(key: str) -> Key:
+    parts = key.split(".")
+    if len(parts) == 3 and parts[0] == "materials" and parts[1] in ("moving", "stationary"):
+        spec = SCHEMA["material"].get(parts[2])
+    elif len(parts) == 2 and parts[0] in SCHEMA:
+        spec = SCHEMA[parts[0]].get(parts[1])
+    else:
+        spec = None
+    if spec is None or spec.kind not in ("wear_coefficient", "energy_wear_coefficient", "number", "force", "length",
+                                         "pressure", "stiffness"):
+        raise CaseError(key, [("--fit", f"{key} is not a numeric case value that can be fitted; e.g. "
+                                        f"{', '.join(DEFAULT_FIT)} or loading.friction_coefficient")], "fit")
+    return spec
+
+
+def read_measured(path: str | Path) -> Measured:
+    """The measurements: every problem with the file, its column and its row."""
+    path = Path(path)
+    source = str(path)
+    problems = []
+    try:
+        with open(path, newline="", encoding="utf-8") as fh:
+            rows = list(csv.reader(fh))
+    except (OSError, UnicodeDecodeError) as exc:
+        raise CaseError(source, [("", f"cannot read it: {exc}")], "measurements") from None
+    rows = [r for r in rows if r and not r[0].lstrip().startswith("#")]
+    if len(rows) < 2:
+        raise CaseError(source, [("", "expected a header like `cycle [cycles],max_wear_depth_stationary [um]` and "
+                                      "at least one row")], "measurements")
+    columns = []
+    for j, text in enumerate(rows[0]):
+        m = _HEADER.match(text)
+        if not m:
+            problems.append((f"column {j + 1}", f"could not read the header {text!r}; expected `name [unit]`"))
+            columns.append((None, None, None))
+            continue
+        name, unit = m.group(1), (m.group(2) or "").strip()
+        if name == "cycle":
+            columns.append((name, None, None))
+        elif name == "x":
+            columns.append((name, "length", unit))
+        elif name in LIMIT_KEYS:
+            kind = LIMITS_SCHEMA[name].kind
+            columns.append((name, kind, unit))
+        elif name in PROFILES:
+            columns.append((name, "length", unit))
+        else:
+            known = ", ".join([*LIMIT_KEYS, *PROFILES])
+            problems.append((f"column {name}", f"not a quantity fretsim reports; expected cycle and any of {known}"))
+            columns.append((None, None, None))
+            continue
+        if name != "cycle" and columns[-1][1] != "fraction" and not unit:
+            problems.append((f"column {name}", f"no unit; write e.g. `{name} [um]`"))
+    names = [c[0] for c in columns]
+    if "cycle" not in names:
+        problems.append(("header", "no `cycle` column"))
+    profile = "x" in names
+    if profile and not any(n in PROFILES for n in names):
+        problems.append(("header", f"an x column needs a profile column ({', '.join(PROFILES)})"))
+    if problems:
+        raise CaseError(source, problems, "measurements")
+    cyc, keys, vals, xs = [], [], [], []
+    for i, row in enumerate(rows[1:], start=2):
+        cells = dict(zip(names, row))
+        try:
+            n = float(cells["cycle"])
+        except (KeyError, ValueError):
+            problems.append((f"row {i}", f"cycle {cells.get('cycle')!r} is not a number"))
+            continue
+        if not (n > 0 and n == int(n)):
+            problems.append((f"row {i}", f"cycle {cells['cycle']!r}: expected a whole number of cycles above 0"))
+            continue
+        x = float("nan")
+        for (name, kind, unit), text in zip(columns, row):
+            if name in (None, "cycle") or text.strip() in ("", "nan", "NaN"):
+                continue
+            try:
+                if kind == "fraction":
+                    value = float(text.strip().rstrip("%")) / (100.0 if text.strip().endswith("%") or unit == "%"
+                                                                else 1.0)
+                else:
+                    value = parse_quantity(f"{text.strip()} {unit}", kind)
+            except (UnitError, ValueError) as exc:
+                problems.append((f"row {i}, column {name}", str(exc)))
+                continue
+            if name == "x":
+                x = value
+                continue
+            if profile != (name in PROFILES):
+                continue
+            if name not in PROFILES and value <= 0:
+                problems.append((f"row {i}, column {name}", f"{text!r}: a measured {name} must be above 0"))
+                continue
+            cyc.append(int(n))
+            keys.append(name)
+            vals.append(value)
+            xs.append(x)
+        if profile and not math.isfinite(x):
+            problems.append((f"row {i}", "no x for the profile's point"))
+    if problems:
+        raise CaseError(source, problems[:30], "measurements")
+    if not vals:
+        raise CaseError(source, [("", "no measured values")], "measurements")
+    return Measured(source, np.array(cyc), keys, np.array(vals, float), np.array(xs, float),
+                    {c[0]: c[2] for c in columns if c[0]})
+
+
+class _Collect:
+    """Observer: the quantities of the measurements at the recorded states."""
+
+    def __init__(self, measured: Measured, wall: Optional[float]):
+        self.m, self.wall, self.at = measured, wall, {}
+
+    def on_step(self, setup, step) -> None:
+        if step.is_snapshot and step.cycle in set(self.m.cycles.tolist()):
+            self.at[int(step.cycle)] = (step, setup.grid)
+
+
+def _model(case: Case, measured: Measured) -> np.ndarray:
+    """The run's value of every measured datum."""
+    from fretsim.limits import value
+    from fretsim.runner import run
+    from fretsim.simulate import centre_line
+    wall = getattr(case.geometry, "wall", None)
+    obs = _Collect(measured, wall)
+    out = run(case, None, observers=(obs,))
+    if out.status != "complete":
+        raise RuntimeError(f"a run of the fit stopped: {out.message}")
+    res = []
+    for n, key, x in zip(measured.cycles, measured.keys, measured.x):
+        step, grid = obs.at[int(n)]
+        if key in PROFILES:
+            h = step.wear_moving if PROFILES[key] == "moving" else step.wear_stationary
+            res.append(float(np.interp(x, grid.x, centre_line(h))))
+        else:
+            res.append(value(key, step, grid, wall))
+    return np.array(res)
+
+
+def shown(value: float, key: str, measured: Measured) -> str:
+    """A datum in the unit its column was written in."""
+    unit = measured.units.get(key)
+    kind = "length" if key in PROFILES else LIMITS_SCHEMA[key].kind
+    if kind == "fraction" or not unit:
+        return f"{value:.5g}"
+    return f"{value / parse_quantity(f'1 {unit}', kind):.5g} {unit}"
+
+
+def _residuals(model: np.ndarray, measured: Measured) -> np.ndarray:
+    r = np.empty_like(model)
+    for i, key in enumerate(measured.keys):
+        if key in PROFILES:  # against the profile's deepest measured point at that cycle
+            same = [j for j, (k, n) in enumerate(zip(measured.keys, measured.cycles)) if k == key and
+                    n == measured.cycles[i]]
+            scale = max(abs(measured.values[j]) for j in same)
+            r[i] = (model[i] - measured.values[i]) / scale
+        else:
+            r[i] = model[i] / measured.values[i] - 1.0
+    return r
+
+
+@dataclass
+class FitResult:
+    keys: tuple
+    start: np.ndarray  # internal units
+    values: np.ndarray
+    low: np.ndarray  # 95 % confidence interval (NaN where there are no degrees of freedom)
+    high: np.ndarray
+    residuals: np.ndarray  # relative, at the optimum
+    model: np.ndarray
+    measured: Measured
+    runs: int
+    dof: int
+    message: str
+    kinds: tuple = ()
+
+    @property
+    def converged(self) -> bool:
+        """A fit that explains the data within the search (not at a bound)."""
+        return "edge of the search" not in self.message
+
+    def overrides(self) -> list[str]:
+        return [f"{k}={_written(v, kind)}" for k, v, kind in zip(self.keys, self.values, self.kinds)]
+
+
+def _written(value: float, kind: str) -> str:
+    return repr(float(value)) if kind == "number" else format_quantity(value, kind)
+
+
+def _start(case: Case, key: str, spec: Key) -> float:
+    node = case.to_dict()
+    for part in key.split("."):
+        node = node.get(part) if isinstance(node, dict) else None
+    if node is None:
+        raise CaseError(case.source, [(key, "not set in the case: give it a starting value to fit")], "fit")
+    return float(node) if spec.kind == "number" else parse_quantity(node, spec.kind)
+
+
+def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overrides=(),
+        progress: Optional[Callable[[int], None]] = None) -> FitResult:
+    """Fit ``keys`` of the case to the measurements."""
+    from scipy.optimize import least_squares
+    from scipy.stats import t as student
+    keys = tuple(keys)
+    specs = [_spec(k) for k in keys]
+    cycles = sorted(set(measured.cycles.tolist()))
+    base = [*overrides, f"loading.cycles={max(cycles)}", f"output.snapshots=[{', '.join(map(str, cycles))}]",
+            "grid.error_estimate=none"]
+    case0 = parse_case(case_text, source=source, overrides=base)
+    base.append(f"jumping.tolerance={min(case0.step_tolerance, FIT_TOLERANCE)}")
+    start = np.array([_start(case0, k, s) for k, s in zip(keys, specs)])
+    if (start <= 0).any():
+        raise CaseError(source, [(k, "a fitted value must start above 0") for k, v in zip(keys, start) if v <= 0],
+                        "fit")
+    # the grid and the automatic choices fixed once, at the starting values: every run compares like with like
+    from fretsim.plan import prepare
+    _, filled, _ = prepare(parse_case(case_text, source=source, overrides=base))
+    fixed = [f"model.dimension={filled.dimension}", f"grid.domain=[{', '.join(f'{d!r} mm' for d in filled.domain)}]",
+             f"grid.elements=[{', '.join(map(str, filled.elements))}]",
+             f"model.corrections={'none' if not filled.corrections or filled.corrections == 'none' else list(filled.corrections)}",
+             f"model.slip={filled.slip}",
+             # the paper's mid-stroke gap is unstable where the moving body wears too little, which a search over
+             # the coefficients can reach: the stroke-averaged gap is stable for any (unless the case names one)
+             f"model.gap={case0.gap_model if case0.gap_model != 'auto' else 'stroke_average'}"]
+    runs = [0]
+    cache: dict = {}
+
+    def evaluate(logs: np.ndarray) -> np.ndarray:
+        key = tuple(np.round(logs, 12))
+        if key not in cache:
+            vals = np.exp(logs)
+            sets = [f"{k}={_written(v, s.kind)}" for k, v, s in zip(keys, vals, specs)]
+            try:
+                case = parse_case(case_text, source=source, overrides=[*base, *fixed, *sets])
+                cache[key] = _model(case, measured)
+            except (CaseError, SimulationError) as exc:
+                raise RuntimeError(f"at {', '.join(sets)}: {exc}") from None
+            runs[0] += 1
+            if progress is not None:
+                progress(runs[0])
+        return _residuals(cache[key], measured)
+
+    x0 = np.log(start)
+    lo, hi = x0 - math.log(RANGE), x0 + math.log(RANGE)
+    sol = least_squares(evaluate, x0, bounds=(lo, hi), diff_step=DIFF_STEP, x_scale=1.0, xtol=1e-6, ftol=1e-8,
+                        max_nfev=200)
+    r = evaluate(sol.x)
+    m, p = r.size, len(keys)
+    dof = m - p
+    low = high = np.full(p, np.nan)
+    if dof > 0:
+        jac = sol.jac
+        s2 = float(r @ r) / dof
+        try:
+            cov = s2 * np.linalg.inv(jac.T @ jac)
+            half = student.ppf(0.975, dof) * np.sqrt(np.clip(np.diag(cov), 0, None))
+            low, high = np.exp(sol.x - half), np.exp(sol.x + half)
+        except np.linalg.LinAlgError:
+            pass
+    message = ("" if dof > 0 else f"{m} measured value(s) for {p} fitted value(s): no degrees of freedom left, so no "
+                                  f"confidence interval (measure more, or fit fewer values)")
+    if dof > 0 and not np.isfinite(low).all():
+        message = "the data do not determine every value (the Jacobian is singular): fit fewer values"
+    at_bound = [k for k, x, a, b in zip(keys, sol.x, lo, hi) if min(x - a, b - x) < 1e-3]
+    if at_bound:
+        message = (f"{', '.join(at_bound)} ended at the edge of the search ({RANGE:g}× from the start): the model "
+                   f"cannot reproduce the data with values in that range (see the residuals); the values are "
+                   f"not a fit" + (f"; {message}" if message else ""))
+    return FitResult(keys, start, np.exp(sol.x), low, high, r, cache[tuple(np.round(sol.x, 12))], measured, runs[0],
+                     dof, message or sol.message, tuple(s.kind for s in specs))
+
+
+def fitted_case_text(case_text: str, result: FitResult) -> str:
+    """The case file's mapping with the fitted values set (comments are not kept)."""
+    import yaml
+
+    from fretsim.case import _apply_override
+    from fretsim.yamlread import loads
+    raw = loads(case_text)
+    problems: list = []
+    for item in result.overrides():
+        _apply_override(raw, item, problems)
+    header = "# fitted by fretsim fit to " + Path(result.measured.source).name + ": " + ", ".join(
+        f"{k} = {_written(v, kind)}" for k, v, kind in zip(result.keys, result.values, result.kinds)) + "\n"
+    return header + yaml.safe_dump(raw, sort_keys=False, allow_unicode=True)

@@ -1,0 +1,414 @@
+"""Load histories and wear limits: blocks of load, stroke and cycles; the cycle at which a limit is reached."""
+import numpy as np
+import pytest
+
+from fretsim.api import load_case, parse_case, run
+from fretsim.case import CaseError
+from fretsim.loading import Block, expand
+from fretsim.results import read_results
+from fretsim.runner import resume
+from fretsim.simulate import DEPTH_SHARE
+
+BASE = """
+name: {name}
+geometry:  {{type: cylinder_on_flat, radius: 6 mm, length: 10 mm}}
+materials:
+  moving:     {{youngs_modulus: 200 GPa, poissons_ratio: 0.3, wear_coefficient: 2.0e-8 1/MPa}}
+  stationary: {{youngs_modulus: 200 GPa, poissons_ratio: 0.3, wear_coefficient: 1.0e-8 1/MPa}}
+model: {{dimension: 2d}}
+grid: {{error_estimate: none}}
+"""
+SINGLE = "loading: {normal_load: 185 N, stroke: 25 um, cycles: 12000}\n"
+HALVES = ("loading:\n  blocks:\n    - {normal_load: 185 N, stroke: 25 um, cycles: 6000}\n"
+          "    - {normal_load: 185 N, stroke: 25 um, cycles: 6000}\n")
+MIXED = ("loading:\n  blocks:\n    - {normal_load: 300 N, stroke: 25 um, cycles: 3000}\n"
+         "    - {normal_load: 100 N, stroke: 40 um, cycles: 5000}\n    - {normal_load: 185 N, stroke: 10 um, cycles: 4000}\n")
+DEPTHS = ("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "centre_wear_depth_stationary_um")
+
+
+def case(loading: str, extra: str = "", name: str = "service", overrides=()):
+    return parse_case(BASE.format(name=name) + loading + extra, overrides=list(overrides))
+
+
+def test_two_equal_blocks_equal_the_single_loading_to_the_stepping_tolerance():
+    """A block boundary restarts the stepping (two per-cycle steps, BDF2 from first order) but changes nothing
+    physical: the depths agree to the depths' share of the stepping tolerance (measured: 1e-7)."""
+    one, two = run(case(SINGLE)), run(case(HALVES))
+    tol = one.case.step_tolerance * DEPTH_SHARE
+    for k in DEPTHS:
+        assert two.summary[k] == pytest.approx(one.summary[k], rel=tol), k
+    assert two.summary["wear_volume_stationary_mm3"] == pytest.approx(one.summary["wear_volume_stationary_mm3"],
+                                                                      rel=1e-12)
+    assert two.case.elements == one.case.elements  # the same grid: the history's total wear sizes it
+
+
+@pytest.mark.parametrize("scheme", ["bdf2", "linear", "adaptive"])
+def test_a_load_history_conserves_the_generalised_archard_volume(scheme, tmp_path):
+    """Each body's volume is k·Σ Pᵢ·4δᵢ·Nᵢ over the blocks, to round-off, whatever the stepping; every block
+    boundary is a step, and the history records each step's block."""
+    c = case(MIXED, overrides=[f"jumping.scheme={scheme}"])
+    out = run(c, tmp_path / "h.h5")
+    assert out.status == "complete"
+    expected = sum(p * 4 * d * n for p, d, n in ((300, 0.025, 3000), (100, 0.040, 5000), (185, 0.010, 4000)))
+    assert out.summary["wear_volume_moving_mm3"] == pytest.approx(2e-8 * expected, rel=1e-9)
+    assert out.summary["wear_volume_stationary_mm3"] == pytest.approx(1e-8 * expected, rel=1e-9)
+    h = read_results(tmp_path / "h.h5").history
+    for boundary, block in ((3000, 0), (8000, 1), (12000, 2)):
+        assert boundary in h["cycle"]
+        assert h["block"][list(h["cycle"]).index(boundary)] == block
+    assert list(np.unique(h["block"])) == [0, 1, 2] and (np.diff(h["block"]) >= 0).all()
+
+
+def test_the_block_order_matters_and_the_model_sees_it():
+    """Heavy then light against light then heavy: the same Archard volume, different depths (a wear process is
+    path dependent); a loop that ignored the blocks would give the same depths."""
+    a = run(case("loading:\n  blocks:\n    - {normal_load: 400 N, stroke: 25 um, cycles: 4000}\n"
+                 "    - {normal_load: 50 N, stroke: 25 um, cycles: 4000}\n"))
+    b = run(case("loading:\n  blocks:\n    - {normal_load: 50 N, stroke: 25 um, cycles: 4000}\n"
+                 "    - {normal_load: 400 N, stroke: 25 um, cycles: 4000}\n"))
+    assert a.summary["wear_volume_moving_mm3"] == pytest.approx(b.summary["wear_volume_moving_mm3"], rel=1e-9)
+    assert a.summary["scar_width_stationary_mm"] != pytest.approx(b.summary["scar_width_stationary_mm"], rel=1e-3)
+
+
+def test_repeats_and_spectra_expand_to_exact_totals():
+    blocks = (Block(10.0, 0.01, 5), Block(20.0, 0.02, 3))
+    assert [b.cycles for b in expand(blocks, 2)] == [5, 3, 5, 3]
+    assert [b.cycles for b in expand(blocks, cycles=12)] == [5, 3, 4]  # the last pass cut short
+    spectrum = (Block(10.0, 0.01, 0, fraction=0.7), Block(20.0, 0.02, 0, fraction=0.3))
+    parts = expand(spectrum, 3, 1001, True)
+    assert sum(b.cycles for b in parts) == 1001
+    assert sum(b.cycles for b in parts if b.normal_load == 10.0) == 701
+    c = case("loading:\n  cycles: 10000\n  repeat: 4\n  spectrum:\n"
+             "    - {normal_load: 150 N, stroke: 30 um, fraction: 70 %}\n"
+             "    - {normal_load: 250 N, stroke: 15 um, fraction: 0.3}\n")
+    assert c.cycles == 10000 and len(c.history()) == 8
+    assert c.normal_load == 250.0 and c.stroke == pytest.approx(0.030)
+
+
+@pytest.mark.parametrize("loading, extra, path, words", [
+    ("loading:\n  normal_load: 185 N\n  blocks:\n    - {normal_load: 185 N, stroke: 25 um, cycles: 10}\n", "",
+     "loading.normal_load", "the blocks carry it"),
+    ("loading:\n  cycles: 100\n  spectrum:\n    - {normal_load: 1 N, stroke: 25 um, fraction: 0.5}\n", "",
+     "loading.spectrum", "add up to 0.5"),
+    ("loading:\n  blocks:\n    - {normal_load: 185, stroke: 25 um, cycles: 10}\n", "",
+     "loading.blocks[0].normal_load", "without a unit"),
+    ("loading:\n  blocks:\n    - {normal_load: 185 N, strok: 25 um, cycles: 10}\n", "",
+     "loading.blocks[0].strok", "did you mean 'stroke'"),
+    (SINGLE, "limits: {wall_loss: 40 %}\n", "limits.wall_loss", "a tube's"),
+    (SINGLE, "limits: {max_depth: 2 um}\n", "limits.max_depth", "did you mean"),
+    (SINGLE, "limits: {max_wear_depth_moving: 2 N}\n", "limits.max_wear_depth_moving", "is a force"),
+    ("loading: {normal_load: 185 N, stroke: 25 um, cycles: 10, frequency: 20}\n", "", "loading.frequency",
+     "without a unit"),
+])
+def test_bad_histories_and_limits_are_refused_naming_the_key(loading, extra, path, words):
+    with pytest.raises(CaseError) as err:
+        case(loading, extra)
+    text = str(err.value)
+    assert path in text and words in text, text
+
+
+LIMIT = "limits: {max_wear_depth_stationary: 0.8 um}\n"
+
+
+@pytest.mark.parametrize("loading", [SINGLE.replace("12000", "100000"), MIXED.replace("4000}", "90000}")],
+                         ids=["constant", "blocks"])
+def test_the_limits_cycle_matches_the_exact_per_cycle_run(loading):
+    """BDF2 lands on the crossing (taking a step again where it passed it) and interpolates it; the per-cycle
+    update (linear jumps of one cycle: the paper's exact model) gives it to within a cycle.  They agree to the
+    depths' share of the stepping tolerance over the growth exponent (measured: 1.5e-5 at 1.5 µm, constant; 7e-4
+    with the blocks, where the third block's 10 µm stroke wears slowly)."""
+    stepped = run(case(loading, LIMIT))
+    exact = run(case(loading, LIMIT, overrides=["jumping.scheme=linear", "jumping.linear=1"]))
+    for out in (stepped, exact):
+        assert out.status == "complete"
+        assert out.summary["limit_reached"] == "max_wear_depth_stationary"
+        assert out.summary["max_wear_depth_stationary_um"] == pytest.approx(0.8, rel=2e-3)
+        assert out.summary["cycles"] < out.case.cycles  # stopped early, at the limit
+    # the depths are held to DEPTH_SHARE of the stepping tolerance, and a depth error ε moves the crossing of a
+    # quantity growing as N^e by ε/e (e = d ln q / d ln N at the crossing, which the run records)
+    exponent = stepped.last.limit[3]
+    assert 0.1 < exponent <= 1.0
+    tol = stepped.case.step_tolerance * DEPTH_SHARE / exponent
+    assert stepped.summary["cycles_to_limit"] == pytest.approx(exact.summary["cycles_to_limit"], rel=tol)
+    assert stepped.summary["contact_solves"] < exact.summary["contact_solves"] / 20
+
+
+def test_a_limit_not_reached_leaves_the_run_complete_and_says_so():
+    out = run(case(SINGLE, "limits: {max_wear_depth_stationary: 1 mm}\n"))
+    assert out.status == "complete" and out.summary["cycles"] == 12000
+    assert out.summary["limit_reached"] == "" and np.isnan(out.summary["cycles_to_limit"])
+
+
+def test_the_time_to_a_limit_follows_the_frequency():
+    out = run(case(SINGLE.replace("12000", "100000").replace("}", ", frequency: 20 Hz}"), LIMIT))
+    assert out.summary["time_to_limit_h"] == pytest.approx(out.summary["cycles_to_limit"] / 20 / 3600, rel=1e-12)
+
+
+def test_the_cycles_to_limit_estimate_covers_its_error_against_a_finer_grid_and_tighter_steps():
+    """The estimate (stepping and interpolation over the depth's growth exponent, plus the companion grid's own
+    crossing) against the same case on a grid 4× finer at a tenth of the tolerance."""
+    text = SINGLE.replace("12000", "100000")
+    out = run(parse_case(BASE.format(name="s").replace("grid: {error_estimate: none}", "grid: {}") + text + LIMIT))
+    f = out.case
+    ref = run(case(text, LIMIT, overrides=[
+        f"jumping.tolerance={f.step_tolerance / 10}", f"grid.domain=[{f.domain[0]!r} mm]",
+        f"grid.elements=[{f.elements[0] * 4 + 1}]"]))
+    actual = abs(out.summary["cycles_to_limit"] / ref.summary["cycles_to_limit"] - 1)
+    assert actual <= out.summary["estimated_error_cycles_to_limit"], (actual, out.summary)
+
+
+def test_a_tubes_wall_loss_limit_stops_at_that_fraction_of_its_wall(tmp_path):
+    c = load_case(pytest.importorskip("pathlib").Path(__file__).parents[1] / "cases" / "tube_RT.yaml",
+                  ["model.dimension=2d", "loading.cycles=100000000", "limits.wall_loss=5 %",
+                   "grid.error_estimate=none"])
+    out = run(c)
+    assert out.summary["limit_reached"] == "wall_loss"
+    assert out.summary["max_wear_depth_moving_um"] == pytest.approx(0.05 * 1000, rel=2e-3)  # a 1 mm wall
+
+
+class _StopAt:
+    def __init__(self, k):
+        self.k, self.n = k, 0
+
+    def on_step(self, setup, step):
+        self.n += 1
+        if self.n == self.k:
+            raise KeyboardInterrupt
+
+
+def test_a_history_with_a_limit_interrupted_anywhere_resumes_to_identical_arrays(tmp_path):
+    """Interrupted at the start, at a block boundary and after a limit's retaken step: the checkpoint carries the
+    block, its start and the limit's track."""
+    c = case(MIXED.replace("4000}", "9000}"), LIMIT)
+    run(c, tmp_path / "full.h5")
+    full = read_results(tmp_path / "full.h5")
+    boundary_row = list(full.history["cycle"]).index(3000) + 1  # emitted steps count from 1
+    for k in (3, boundary_row, boundary_row + 1, len(full.history["cycle"]) - 1):
+        part = tmp_path / f"part{k}.h5"
+        with pytest.raises(KeyboardInterrupt):
+            run(c, part, observers=(_StopAt(k),))
+        assert resume(part).status == "complete"
+        again = read_results(part)
+        for name in full.history:
+            if name != "wall_time":
+                assert np.array_equal(full.history[name], again.history[name], equal_nan=True), (k, name)
+        assert again.summary["cycles_to_limit"] == full.summary["cycles_to_limit"]
+
+
+# --- uncertainty: distributed sweep axes, Latin hypercube, percentiles --------------------------------------------
+
+import csv  # noqa: E402
+import math  # noqa: E402
+from pathlib import Path  # noqa: E402
+
+from scipy.stats import norm  # noqa: E402
+
+from fretsim.sweep import load_sweep, run_sweep  # noqa: E402
+from fretsim.uncertainty import check, sample  # noqa: E402
+
+CASES = Path(__file__).resolve().parents[1] / "cases"
+SAMPLED = f"""
+base: {CASES / 'mccoll_185N.yaml'}
+set: [model.dimension=2d, loading.cycles=60, "output.snapshots=[60]", grid.error_estimate=none]
+sample: {{n: 60, seed: 3}}
+axes:
+  materials.moving.wear_coefficient: {{distribution: lognormal, median: 2e-8 1/MPa, factor: 2}}
+  loading.stroke: [10 um, 25 um]
+"""
+
+
+def test_the_latin_hypercube_samples_each_stratum_once_in_the_axis_unit():
+    specs = {"a": {"distribution": "uniform", "low": "1 N", "high": "3 N"},
+             "b": {"distribution": "normal", "mean": 0.5, "sd": 0.1}}
+    pts = sample(specs, 50, seed=7)
+    a = np.array([float(p["a"].split()[0]) for p in pts])
+    assert all(p["a"].endswith(" N") for p in pts)
+    assert sorted(np.floor((a - 1) / 2 * 50).astype(int)) == list(range(50))  # one sample per stratum
+    b = np.sort([p["b"] for p in pts])
+    strata = np.floor(norm.cdf((b - 0.5) / 0.1) * 50 + 1e-9).astype(int)
+    assert sorted(strata) == list(range(50))
+    assert sample(specs, 50, seed=7) == pts  # the seed makes it reproducible
+
+
+@pytest.mark.parametrize("spec, words", [
+    ({"distribution": "weibull", "k": 1}, "unknown distribution"),
+    ({"distribution": "lognormal", "median": "2e-8 1/MPa"}, "takes median and factor"),
+    ({"distribution": "lognormal", "median": "2e-8 1/MPa", "factor": "2 N"}, "plain number"),
+    ({"distribution": "lognormal", "median": "2e-8 1/MPa", "factor": 0.5}, "factor > 1"),
+    ({"distribution": "uniform", "low": "3 N", "high": "1 N"}, "high > low"),
+    ({"distribution": "normal", "mean": "40 N", "sd": "4 kN"}, "one unit"),
+])
+def test_bad_distributions_are_refused_with_what_they_take(spec, words):
+    assert words in check(spec)
+
+
+def test_a_bad_sample_value_is_refused_by_the_case_parser_naming_the_axis(tmp_path):
+    text = SAMPLED.replace("median: 2e-8 1/MPa", "median: 2e-8 N")
+    path = tmp_path / "bad.yaml"
+    path.write_text(text)
+    with pytest.raises(CaseError) as err:
+        load_sweep(path)
+    assert "wear_coefficient" in str(err.value)
+
+
+def test_the_percentiles_of_the_archard_volume_under_a_lognormal_k_match_the_closed_form(tmp_path):
+    """The worn volume is k·P·4δ·N exactly (the uniform model's invariant), so under k lognormal with median m and
+    geometric standard deviation f its P-th percentile is m·f^z_P·P·4δ·N, per stroke group.  The tolerance is
+    one Latin-hypercube stratum: the sample of stratum i lies within [i, i+1)/n in probability, so an empirical
+    percentile is within 1/n in probability of the true one (1/60 at P10: 5.6 % in k for f = 2)."""
+    path = tmp_path / "u.yaml"
+    path.write_text(SAMPLED)
+    sweep = load_sweep(path)
+    assert len(sweep.points) == 120 and sweep.groups == ["loading.stroke"]
+    out = tmp_path / "u"
+    res = run_sweep(sweep, out, jobs=2)
+    assert res.all_complete
+    with open(out / "percentiles.csv", newline="") as fh:
+        rows = [r for r in csv.DictReader(fh) if r["key"] == "wear_volume_moving_mm3"]
+    assert len(rows) == 2 and {r["loading.stroke"] for r in rows} == {"10 um", "25 um"}
+    for r in rows:
+        stroke = float(r["loading.stroke"].split()[0]) * 1e-3
+        assert r["unit"] == "mm^3" and int(r["points"]) == 60
+        for q in (10, 50, 90):
+            z = norm.ppf(q / 100)
+            exact = 2e-8 * 2 ** z * 185 * 4 * stroke * 60
+            dz = (1 / 60) / norm.pdf(z)
+            tol = math.exp(math.log(2) * dz) - 1
+            assert float(r[f"p{q}"]) == pytest.approx(exact, rel=tol), (q, r)
+
+
+def test_a_sampled_sweeps_plot_draws_the_band_and_the_histogram_of_the_time_to_the_limit(tmp_path):
+    """Data, not pixels: the band's P10 ≤ P50 ≤ P90 everywhere, a sample at its limit held there (the band's P90
+    reaches the limit), and the histogram's counts are every sample that reached it."""
+    from fretsim.plotting import band_data, uncertainty_bands
+    from fretsim.results import read_sweep_table
+    text = f"""
+base: {CASES / 'mccoll_185N.yaml'}
+set: [model.dimension=2d, loading.cycles=20000, "output.snapshots=[0]", grid.error_estimate=none,
+      limits.max_wear_depth_moving=1 um]
+sample: {{n: 12, seed: 3}}
+axes:
+  materials.moving.wear_coefficient: {{distribution: lognormal, median: 2e-8 1/MPa, factor: 2}}
+"""
+    path = tmp_path / "b.yaml"
+    path.write_text(text)
+    out = tmp_path / "b"
+    assert run_sweep(load_sweep(path), out, jobs=2).all_complete
+    table = read_sweep_table(out)
+    assert table.mode == "sample"
+    band = band_data(table)[()]
+    assert (band["p10"] <= band["p50"] + 1e-12).all() and (band["p50"] <= band["p90"] + 1e-12).all()
+    assert band["p90"][-1] == pytest.approx(1.0, rel=5e-3)  # held at the limit once reached
+    reached = [r for r in table.rows if r["limit_reached"]]
+    assert reached
+    paths = uncertainty_bands(table, out, "png", 60)
+    assert [p.name for p in paths] == ["uncertainty_depth_band.png", "uncertainty_time_to_limit.png"]
+
+
+# --- wear coefficients fitted to measurements ---------------------------------------------------------------------
+
+from click.testing import CliRunner  # noqa: E402
+
+from fretsim.cli import main  # noqa: E402
+from fretsim.fit import fit, read_measured  # noqa: E402
+
+TRUTH = ["model.dimension=2d", "materials.moving.wear_coefficient=3e-8 1/MPa",
+         "materials.stationary.wear_coefficient=1.2e-8 1/MPa", "output.snapshots=[3000, 9000, 18000]",
+         "grid.error_estimate=none", "jumping.tolerance=1e-3"]
+
+
+@pytest.fixture(scope="module")
+def synthetic(tmp_path_factory):
+    """Depths of both bodies at three cycles and the flat's final width, from a run with known coefficients,
+    with 1 % noise (seeded)."""
+    tmp = tmp_path_factory.mktemp("fit")
+    run(load_case(CASES / "mccoll_185N.yaml", TRUTH), tmp / "truth.h5")
+    r = read_results(tmp / "truth.h5")
+    rng = np.random.default_rng(1)
+    lines = ["cycle [cycles],max_wear_depth_moving [um],max_wear_depth_stationary [um],scar_width_stationary [mm]"]
+    for i, c in enumerate(r.fields["cycle"]):
+        if c == 0:
+            continue
+        m, s = (r.fields[k][i].max() * (1 + 0.01 * rng.standard_normal()) for k in
+                ("wear_depth_moving", "wear_depth_stationary"))
+        width = f"{r.summary['scar_width_stationary_mm']:.5g}" if c == 18000 else ""
+        lines.append(f"{c},{m:.5g},{s:.5g},{width}")
+    path = tmp / "measured.csv"
+    path.write_text("\n".join(lines) + "\n")
+    return path
+
+
+def test_fit_recovers_known_coefficients_from_noisy_data_within_its_own_interval(synthetic):
+    """Started 1.5× and 2.5× away (the case's own 2e-8 and 3e-8): each fitted coefficient's 95 % interval holds
+    the true one, and the interval is informative (within ±10 %: seven data with 1 % noise)."""
+    text = (CASES / "mccoll_185N.yaml").read_text()
+    res = fit(text, str(CASES / "mccoll_185N.yaml"), read_measured(synthetic), overrides=["model.dimension=2d"])
+    assert res.converged and res.dof == 5
+    for true, lo, hi in zip((3e-8, 1.2e-8), res.low, res.high):
+        assert lo <= true <= hi, (true, lo, hi)
+        assert hi / lo < 1.2
+    assert np.abs(res.residuals).max() < 0.03  # the noise, not a misfit
+
+
+def test_the_fit_command_prints_intervals_and_writes_a_case_that_reruns_the_fit(synthetic, tmp_path):
+    out = tmp_path / "fitted.yaml"
+    r = CliRunner().invoke(main, ["fit", str(CASES / "mccoll_185N.yaml"), "--measured", str(synthetic), "--set",
+                                  "model.dimension=2d", "--fit", "materials.stationary.wear_coefficient", "-o",
+                                  str(out)])
+    assert r.exit_code == 0, r.output
+    assert "materials.stationary.wear_coefficient = " in r.output and "95 % CI" in r.output
+    fitted = load_case(out)
+    assert fitted.stationary.wear_coefficient != pytest.approx(3e-8, rel=0.05)  # moved from the case's value
+    assert fitted.moving.wear_coefficient == pytest.approx(2e-8)  # not fitted: kept
+
+
+@pytest.mark.parametrize("text, words", [
+    ("cycle [cycles],max_depth [um]\n100,1\n", "not a quantity fretsim reports"),
+    ("cycle [cycles],max_wear_depth_stationary\n100,1\n", "no unit"),
+    ("cycle [cycles],max_wear_depth_stationary [N]\n100,1\n", "is a force"),
+    ("cycles,max_wear_depth_stationary [um]\n100,1\n", "column cycles"),
+    ("cycle [cycles],max_wear_depth_stationary [um]\n-5,1\n", "above 0"),
+    ("cycle [cycles],x [mm]\n100,0.1\n", "needs a profile column"),
+])
+def test_bad_measurement_files_are_refused_naming_the_column_or_row(tmp_path, text, words):
+    path = tmp_path / "m.csv"
+    path.write_text(text)
+    r = CliRunner().invoke(main, ["fit", str(CASES / "mccoll_185N.yaml"), "--measured", str(path)])
+    assert r.exit_code == 2 and words in r.output, r.output
+    assert "Traceback" not in r.output
+
+
+def test_fit_recovers_a_coefficient_from_a_whole_measured_profile(tmp_path):
+    """The flat's centre-line profile at the end (every fourth element, 1 % noise) fits k_s alone, started at
+    2.5× the truth: its interval holds it."""
+    truth = tmp_path / "t.h5"
+    run(load_case(CASES / "mccoll_185N.yaml", TRUTH), truth)
+    r = read_results(truth)
+    depth = r.fields["wear_depth_stationary"][-1][0]
+    rng = np.random.default_rng(2)
+    lines = ["cycle [cycles],x [mm],wear_depth_stationary [um]"]
+    for x, d in list(zip(r.x, depth))[::4]:
+        if d > 0.05 * depth.max():
+            lines.append(f"18000,{x:.6g},{d * (1 + 0.01 * rng.standard_normal()):.5g}")
+    path = tmp_path / "profile.csv"
+    path.write_text("\n".join(lines) + "\n")
+    text = (CASES / "mccoll_185N.yaml").read_text()
+    res = fit(text, str(CASES / "mccoll_185N.yaml"), read_measured(path),
+              ["materials.stationary.wear_coefficient"],
+              overrides=["model.dimension=2d", "materials.moving.wear_coefficient=3e-8 1/MPa"])
+    assert res.converged and res.dof > 10
+    assert res.low[0] <= 1.2e-8 <= res.high[0], (res.low, res.high)
+
+
+def test_blocks_with_their_own_friction_coefficients_run_coulomb_and_keep_the_invariant():
+    """Per-block μ with Coulomb friction: each block's cycle model has its own μ, and the volume is k·Σp|ds|A,
+    the work the cycles accumulate, to round-off."""
+    c = case("loading:\n  friction_coefficient: 0.9\n  blocks:\n"
+             "    - {normal_load: 185 N, stroke: 25 um, cycles: 2000}\n"
+             "    - {normal_load: 185 N, stroke: 25 um, cycles: 2000, friction_coefficient: 0.3}\n",
+             overrides=["model.slip=coulomb"])
+    assert [b.friction_coefficient for b in c.history()] == [0.9, 0.3]
+    out = run(c)
+    assert out.status == "complete", out.message
+    assert out.summary["archard_volume_error"] < 1e-9
+    assert out.summary["wear_volume_moving_mm3"] == pytest.approx(2e-8 * out.last.work, rel=1e-9)
