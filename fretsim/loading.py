@@ -72,13 +72,6 @@ class Loading:
     def cycles(self) -> int:
         return sum(b.cycles for b in self.blocks)
 
-    @property
-    def block(self) -> Block:
-        """The block of a single-block loading (every loading today)."""
-        if len(self.blocks) != 1:
-            raise ValueError(f"this loading has {len(self.blocks)} blocks; ask for one by cycle")
-        return self.blocks[0]
-
     def block_at(self, cycle: int) -> Block:
         """The block that cycle ``cycle`` + 1 belongs to (the last block from its start on)."""
         return self.blocks[self.index_at(cycle)]
@@ -101,10 +94,3 @@ class Loading:
             ends.append(n)
         return tuple(ends)
 
-    def start_of(self, index: int) -> int:
-        return sum(b.cycles for b in self.blocks[:index])
-
-
-def single(normal_load: float, stroke: float, cycles: int, friction_coefficient: Optional[float] = None,
-           tangential_stiffness: Optional[float] = None) -> Loading:
-    return Loading((Block(normal_load, stroke, cycles, friction_coefficient, tangential_stiffness),))

@@ -595,16 +595,20 @@ class Results:
     def status(self) -> str:
         return self.attrs.get("status", "")
 
+    def _case_section(self, name: str) -> dict:
+        """A top-level mapping of the stored case ({} where absent or not a mapping)."""
+        from fretsim.yamlread import YamlProblem, loads
+        try:
+            section = (loads(self.case_yaml) or {}).get(name) or {}
+        except (YamlProblem, AttributeError):
+            return {}
+        return section if isinstance(section, dict) else {}
+
     def depth_limits(self) -> dict:
         """The case's wear limits on depths (key → (µm, as written)): what the history figure draws."""
         from fretsim.units import UnitError, parse_quantity
-        from fretsim.yamlread import YamlProblem, loads
-        try:
-            limits = (loads(self.case_yaml) or {}).get("limits") or {}
-        except (YamlProblem, AttributeError):
-            return {}
         out = {}
-        for key, text in limits.items() if isinstance(limits, dict) else ():
+        for key, text in self._case_section("limits").items():
             if "wear_depth" in str(key):
                 try:
                     out[key] = (parse_quantity(text, "length") * 1e3, str(text))
@@ -616,13 +620,8 @@ class Results:
         """source (experiment, fea, paper) → (the flat's centre-line depth µm, its scar width mm) from the case's
         `expected:` data (None where absent): what figures compare with."""
         from fretsim.units import UnitError, parse_quantity
-        from fretsim.yamlread import YamlProblem, loads
-        try:
-            expected = (loads(self.case_yaml) or {}).get("expected") or {}
-        except (YamlProblem, AttributeError):
-            return {}
         out = {}
-        for source, values in expected.items() if isinstance(expected, dict) else ():
+        for source, values in self._case_section("expected").items():
             if not isinstance(values, dict):
                 continue
             got = []
