@@ -118,7 +118,12 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "energy_wear_coefficient": Key("energy_wear_coefficient", "energy wear coefficient α (Fouvry): worn volume "
                                                                   "per dissipated energy, dh = α·|q|·|ds|; "
                                                                   "required with model.wear_law energy", None,
-                                       plausible=(0.0, 1.0, "0 to 1000 mm3/J"), positive=False)},
+                                       plausible=(0.0, 1.0, "0 to 1000 mm3/J"), positive=False),
+        "yield_strength": Key("pressure", "tensile yield strength σ_y, optional: `check` and `run` warn where the "
+                                          "unworn Hertz peak pressure passes the onset of yield below the surface "
+                                          "(p0 = 1.60 σ_y for a point contact, 1.79 σ_y for a line contact; von "
+                                          "Mises, ν = 0.3, Johnson §6.2)", None,
+                              plausible=(1.0, 1e5, "1 MPa to 100 GPa"), example="250 MPa")},
     "loading": {
         "normal_load": Key("force", "normal load P (total, both in 2D and 3D)", REQUIRED,
                            plausible=(1e-6, 1e7, "1 µN to 10 MN"), example="185 N"),
@@ -253,6 +258,7 @@ class Material:
     poissons_ratio: float
     wear_coefficient: Optional[float]  # 1/MPa (Archard's k)
     energy_wear_coefficient: Optional[float] = None  # mm³/(N·mm) = 1/MPa (α)
+    yield_strength: Optional[float] = None  # MPa (σ_y, for the elastic model's range only)
 
 
 @dataclass(frozen=True)
@@ -353,6 +359,8 @@ class Case:
                 out["wear_coefficient"] = format_quantity(m.wear_coefficient, "wear_coefficient")
             if m.energy_wear_coefficient is not None:
                 out["energy_wear_coefficient"] = format_quantity(m.energy_wear_coefficient, "energy_wear_coefficient")
+            if m.yield_strength is not None:
+                out["yield_strength"] = format_quantity(m.yield_strength, "pressure")
             return out
 
         grid: dict = {}

@@ -26,6 +26,7 @@ EXIT_FAILED = 3
 EXIT_STOPPED = 4
 EXIT_IO = 5
 EXIT_INTERRUPTED = 130
+EXIT_BROKEN_PIPE = 141  # 128 + SIGPIPE, as a shell tool whose reader has gone
 
 
 class Fail(Exception):
@@ -43,6 +44,12 @@ def _boundary(command):
     def guarded(*args, **kwargs):
         try:
             return command(*args, **kwargs)
+        except BrokenPipeError:  # the reader went away (`fretsim summary … | head`): quiet, as shell tools are
+            try:
+                os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())  # nothing more to flush at exit
+            except OSError:
+                pass
+            sys.exit(EXIT_BROKEN_PIPE)
         except (Fail, InputError, ResultsFileError, KeyboardInterrupt, OSError) as exc:
             if isinstance(exc, Fail):
                 code, message = exc.code, str(exc)
@@ -124,18 +131,16 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
 
     def _on_plan(setup, filled, plan):
         if not quiet:
-            for note in setup.notes:
-                click.echo(f"note: {note}", err=True)
+            for note in setup.notes:  # the plan's warnings as check shows them: the model may be out of its range
+                click.echo(f"{'warning' if note in plan.warnings else 'note'}: {note}", err=True)
             long = long_run_note(setup)
             if long:
                 click.echo(long, err=True)
         progress.start(setup)
 
-    import time as _time
     import fretsim.plan as plan_module
-    started = _time.perf_counter()
-    if not quiet:  # auto's proxy runs can take a minute before the first step: say what is running
-        plan_module.announce = lambda what: click.echo(f"[{_time.perf_counter() - started:5.1f} s] {what}", err=True)
+    if not quiet:  # the proxies, a pilot and the companions can take a minute: say what is running, and how far
+        _side_runs(plan_module, progress.stop)
     try:
         previous_handler = signal.signal(signal.SIGTERM, _terminate)
     except ValueError:  # not the main thread (the CLI called from a thread): SIGTERM keeps its handler
@@ -156,7 +161,7 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
     except OSError as exc:  # before any step: the output's place cannot be written
         raise Fail(f"cannot write {output}: {exc.strerror or exc}") from None
     finally:
-        plan_module.announce = None
+        plan_module.announce = plan_module.side_progress = None
         progress.stop()
         try:
             signal.signal(signal.SIGTERM, previous_handler)
@@ -174,6 +179,32 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
         for note in outcome.notes[len(outcome.setup.notes):]:
             click.echo(f"note: {note}", err=True)
     click.echo(_paragraph(outcome))
+
+
+def _side_runs(plan_module, before=lambda: None) -> list:
+    """Have the runs a run makes besides its own say what they are, when (seconds since now) and how far they are
+    (a bar on a terminal).  ``before`` ends what was shown before (the run's own bar)."""
+    import contextlib
+    import time
+    started = time.perf_counter()
+    said: list = []
+
+    def announce(what: str) -> None:
+        before()
+        said.append(what)
+        click.echo(f"[{time.perf_counter() - started:5.1f} s] {what}", err=True)
+
+    @contextlib.contextmanager
+    def side_progress(setup):
+        bar = _Progress(not sys.stderr.isatty())
+        bar.start(setup)
+        try:
+            yield bar.update
+        finally:
+            bar.stop()
+
+    plan_module.announce, plan_module.side_progress = announce, side_progress
+    return said
 
 
 def _status_of(path) -> Optional[str]:
@@ -294,7 +325,8 @@ def _paragraph(outcome) -> str:
     blocks = "" if c.blocks is None else f" ({reached} of the loading's {len(c.history())} blocks)"
     text = (f"{c.name}: {s['cycles']} cycles{blocks}, {c.dimension.upper()} {c.geometry.kind}, {cells} of {size}{refined}, "
             f"{model}, solver {c.solver}, {stepping}; {s['contact_solves']} contact solves in "
-            f"{s['wall_time_s']:.2f} s.")
+            f"{s['wall_time_s']:.2f} s" + (f" (and {s['grid_error_wall_time_s']:.2f} s for the grid-error companions)"
+                                          if s.get("grid_error_wall_time_s", 0) > 0 else "") + ".")
     text += " " + _regime(s, c)
     if s["cycles"] > 0:
         text += (f" Stationary body: centre-line wear depth {s['centre_wear_depth_stationary_um']:.3g} µm "
@@ -323,11 +355,11 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
     from fretsim.api import check as check_case, load_case
 
     started = time.perf_counter()
-    plan_module.announce = lambda what: click.echo(f"[{time.perf_counter() - started:5.1f} s] {what}", err=True)
+    said = _side_runs(plan_module)
     try:
         setup, filled, plan = check_case(load_case(case_file, list(overrides)))
     finally:
-        plan_module.announce = None
+        plan_module.announce = plan_module.side_progress = None
     planning = time.perf_counter() - started
     g = setup.grid
     cells = f"{g.shape[1]} elements of {g.dx * 1e3:.4g} µm" if g.plane_strain else \
@@ -347,19 +379,41 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
         click.echo(f"regime: {regime} at the start — the stroke {filled.stroke * 1e3:.4g} µm is "
                    f"{filled.stroke / d_t:.3g}× the gross-slip limit δ_t = {d_t * 1e3:.4g} µm (μ = "
                    f"{filled.friction_coefficient:g}, the unworn contact)")
-    from fretsim.plan import estimate_cost
-    solves, seconds = estimate_cost(setup)
-    click.echo(f"estimate: about {solves} contact solves, {seconds:.2g} s"
-               + (f", after {planning:.2g} s of planning (auto's proxy runs, which a run repeats)"
-                  if planning > 1.0 else "") + f" (jumping.tolerance {filled.step_tolerance:g})")
+    from fretsim.runner import estimate
+    cost = estimate(setup, filled)
+    total = cost["run_s"] + cost["companions_s"] + (planning if planning > 1.0 else 0.0)
+    click.echo(f"estimate: about {cost['solves']} contact solves, {_seconds(cost['run_s'])} for the run "
+               f"(jumping.tolerance {filled.step_tolerance:g})"
+               + (f"; its grid-error companions ({cost['companions']} runs on coarser grids) about "
+                  f"{_seconds(cost['companions_s'])} more" if cost["companions"] else "")
+               + (f"; planning took {_seconds(planning)} here ({_planning_runs(said)}), which a run repeats"
+                  if planning > 1.0 else "") + f": about {_seconds(total)} in all")
     click.echo("choices:")
     width = max(len(c.key) for c in plan.choices)
     for c in plan.choices:
         click.echo(f"  {c.key:<{width}}  {_show(c.value)}  ({c.reason})")
     for w in plan.warnings:
         click.echo(f"warning: {w}")
-    click.echo("filled case:")
-    click.echo("  " + filled.to_yaml().rstrip().replace("\n", "\n  "))
+    click.echo("filled case (numbers to 6 significant digits; a results file's /case holds them exactly):")
+    click.echo("  " + _rounded(filled.to_yaml()).rstrip().replace("\n", "\n  "))
+
+
+def _planning_runs(said: list) -> str:
+    proxies = sum(w.startswith("model.") for w in said)
+    pilot = any(w.startswith("wear limits") for w in said)
+    runs = ([f"auto's {proxies} proxy run{'s' if proxies > 1 else ''}"] if proxies else []) + \
+        (["a pilot run for the wear limits"] if pilot else [])
+    return " and ".join(runs) or "sizing the grid"
+
+
+def _rounded(text: str) -> str:
+    """The decimals of a text to 6 significant digits: 3.0000000000000004e-08 is 3e-08 to a reader."""
+    import re
+    return re.sub(r"(?<![\w.])-?\d+\.\d+(?:e[-+]?\d+)?(?![\w.])", lambda m: f"{float(m.group()):.6g}", text)
+
+
+def _seconds(t: float) -> str:
+    return f"{t:.2g} s" if t < 120 else f"{t / 60:.2g} min" if t < 7200 else f"{t / 3600:.2g} h"
 
 
 def _show(value) -> str:

@@ -33,6 +33,8 @@ MODEL_GROWTH = math.log(1e3)  # a forced unstable model may grow a seed at most 
 SHORT_RUN = 8  # runs of at most this many cycles are taken a cycle at a time: exact, and as cheap
 MIN_ELEMENTS_ACROSS_CONTACT = 4
 ELASTIC_P0 = 0.04  # p0/E* beyond which no metal stays elastic (bearing steel: ~4 GPa over E* = 115 GPa, 3.5 %)
+# the Hertz peak pressure at first yield (von Mises, ν = 0.3, below the surface): Johnson, Contact Mechanics §6.2
+YIELD_ONSET = {"point": 1.60, "line": 1.79}
 SMALL_CONTACT = 0.1  # a/R beyond which the half-space (small-strain) contact model is said to be stretched
 
 
@@ -131,7 +133,11 @@ def _full_corrections(case: Case, dimension: str):
     return tuple(dict.fromkeys(given + ("free_faces",) + bending))
 
 
-announce: Optional[Callable[[str], None]] = None  # told before each of auto's proxy runs (the CLI prints it)
+# The runs a run makes besides its own (auto's proxies, a limit's pilot, the grid-error companions) can take a
+# minute: the CLI says what each is (announce) and shows its progress (side_progress: a context manager for a
+# setup that yields a progress callback, as simulate takes one).  Both None in the library: nothing is printed.
+announce: Optional[Callable[[str], None]] = None
+side_progress: Optional[Callable[[Any], Any]] = None
 
 
 def _announce(what: str) -> None:
@@ -139,8 +145,34 @@ def _announce(what: str) -> None:
         announce(what)
 
 
+def side_run(what: str, setup):
+    """simulate(setup) for one of the runs a run makes besides its own, announced and with progress."""
+    from fretsim.simulate import simulate
+    _announce(what)
+    if side_progress is None:
+        return simulate(setup)
+    with side_progress(setup) as update:
+        return simulate(setup, progress=update)
+
+
+def _proxy(proxy: Case, what: Callable[[Setup], str]) -> dict:
+    """The summary of one of auto's proxy runs; a proxy already run in this process (the corrections' proxies
+    are asked for again once the dimension is chosen) is not run again."""
+    from fretsim.simulate import summarize
+    key = repr(proxy.to_dict())
+    if key not in _PROXIES:
+        setup, _, _ = prepare(proxy)
+        if len(_PROXIES) > 64:
+            _PROXIES.clear()
+        _PROXIES[key] = summarize(setup, side_run(what(setup), setup), 0, 0.0)
+    return dict(_PROXIES[key])
+
+
+_PROXIES: dict = {}
+
+
 def _dimension_proxy(case: Case, e_star: float) -> tuple[float, str]:
-    from fretsim.simulate import simulate, summarize
+    from fretsim.simulate import summarize
     g = case.geometry
     k = sum(case.wear_coefficients())
     sizing = auto_grid(g, False, case.normal_load, case.stroke, case.cycles, k, e_star)
@@ -154,10 +186,8 @@ def _dimension_proxy(case: Case, e_star: float) -> tuple[float, str]:
                                   elements=elements,
                                   coarse_element=None, linear_jump=None, scheme="bdf2", preset=None,
                                   step_tolerance=max(case.step_tolerance, 0.03))
-        setup, _, _ = prepare(proxy)
-        _announce(f"model.dimension auto: a {dim.upper()} proxy run ({' × '.join(map(str, elements))} elements, "
-                  f"{case.cycles} cycles) to compare 2D with 3D")
-        out.append(summarize(setup, simulate(setup), 0, 0.0))
+        out.append(_proxy(proxy, lambda setup: f"model.dimension auto: a {dim.upper()} proxy run "
+                          f"({' × '.join(map(str, elements))} elements, {case.cycles} cycles) to compare 2D with 3D"))
     diffs = {key: abs(out[1][key] / out[0][key] - 1) if out[0][key] else 0.0 for key in keys}
     worst = max(diffs, key=diffs.get)
     names = {"max_wear_depth_moving_um": "the moving body's maximum depth", "max_wear_depth_stationary_um":
@@ -281,7 +311,7 @@ def _proxy_difference(case: Case, corrections: tuple, dimension: str = "2d") -> 
 
 
 def _run_proxies(case: Case, corrections: tuple, dimension: str) -> tuple[float, str]:
-    from fretsim.simulate import simulate, summarize
+    from fretsim.simulate import summarize
     keys = (("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "scar_width_moving_mm",
              "scar_width_stationary_mm") if case.cycles else ("max_pressure_MPa",))
     grid: dict = {"domain": None, "elements": None}
@@ -299,11 +329,9 @@ def _run_proxies(case: Case, corrections: tuple, dimension: str) -> tuple[float,
                                   coarse_element=None, linear_jump=None, scheme="bdf2", preset=None,
                                   step_tolerance=max(case.step_tolerance, 0.03) if dimension == "3d"
                                   else case.step_tolerance, **grid)
-        setup, _, _ = prepare(proxy)
-        _announce(f"model.corrections auto: a {dimension.upper()} proxy run {'with ' + ', '.join(corr) if corr else 'without corrections'}"
-                  f" ({setup.grid.shape[1]} × {setup.grid.shape[0]} elements, {case.cycles} cycles)")
-        last = simulate(setup)
-        out.append(summarize(setup, last, 0, 0.0))
+        out.append(_proxy(proxy, lambda setup: f"model.corrections auto: a {dimension.upper()} proxy run "
+                          f"{'with ' + ', '.join(corr) if corr else 'without corrections'} ({setup.grid.shape[1]} × "
+                          f"{setup.grid.shape[0]} elements, {case.cycles} cycles)"))
     diffs = {k: abs(out[1][k] / out[0][k] - 1) if out[0][k] else 0.0 for k in keys}
     worst = max(diffs, key=diffs.get)
     names = {"max_wear_depth_moving_um": "the moving body's maximum depth", "max_wear_depth_stationary_um":
@@ -369,19 +397,30 @@ def estimate_solves(setup) -> int:
     return int(n / (setup.linear_jump * 6 + 300)) * 6 + len(setup.snapshots) + 10
 
 
+# a step's solve, warm-started on the contact's window, against the cold solve timed (loop time per solve over one
+# cold solve, measured on McColl 185 N 2D/3D with BDF2 and linear jumps, Kirk 20 Hz, the 3D tube, the partial-slip
+# ball: 0.22-0.56, the 2D runs' per-step overhead the rest; was 0.5, and 1 for friction cycles, which estimated
+# those 1.9-3.6x too long)
+WARM_SOLVE = 0.35
+
+
 def estimate_cost(setup) -> tuple[int, float]:
     """(solves, seconds) before a run: solves from the scheme, seconds from one timed contact solve."""
     import time
 
     from fretsim.solvers import solve
+    from fretsim.compliance import fft
+    fft.forward(np.zeros((1, 3)), (1, 6))  # the FFT's import and choice, once a process: not a solve's cost
     solves = estimate_solves(setup)
     op = setup.coarse_compliance or setup.compliance
+    if op.convolution is not None:
+        op.convolution.hat  # its transform, made once a run: not a solve's cost
     gap = setup.coarse_gap if setup.coarse_gap is not None else setup.gap
     if setup.cycle.linear:  # a cycle is one normal solve
         t = time.perf_counter()
         solve(op, gap, setup.cycle.load, method=setup.method, tol=setup.tolerance)
         cold = time.perf_counter() - t
-        return solves, solves * cold * 0.5  # a warm-started solve on a window takes about half a cold one (measured)
+        return solves, solves * cold * WARM_SOLVE
 
     def normal(seen, guess, extra=None, load=None, cycle=0):
         res = solve(op if extra is None else add(op, extra), gap + seen, load, method=setup.method, p0=guess,
@@ -391,7 +430,7 @@ def estimate_cost(setup) -> tuple[int, float]:
     zero = np.zeros(setup.grid.shape)
     t = time.perf_counter()
     setup.cycle.solve(zero, zero, normal, None)
-    return solves, solves * (time.perf_counter() - t)  # a cycle of increments: its solves warm-start each other
+    return solves, solves * (time.perf_counter() - t) * WARM_SOLVE
 
 
 # --- prepare ----------------------------------------------------------------------------------------------------
@@ -405,17 +444,16 @@ def pilot_cycles(case: Case) -> Optional[float]:
     only use is sizing: a limit's run is sized for the wear at the limit, not for loading.cycles, which is then
     only an upper bound (a scar sized for 10⁹ cycles would make the elements far too coarse for the scar at
     the limit)."""
-    from fretsim.simulate import simulate
     pilot = case.with_choices(dimension="2d" if case.geometry.has_2d else "3d", corrections="none",
                               grid_rule="paper", grid_error="none", step_tolerance=max(case.step_tolerance, 0.03),
                               pressure_accuracy=None, snapshots=(0,), scheme="bdf2")
     key = repr(pilot.to_dict())  # auto's proxies prepare variants of the case: one pilot serves them all
     if key in _PILOTS:
         return _PILOTS[key]
-    _announce("wear limits: a pilot run on the paper's grid to find roughly where the limit is reached")
     try:
         setup, _, _ = prepare(pilot, _pilot=float("nan"))
-        last = simulate(setup)
+        last = side_run("wear limits: a pilot run on the paper's grid to find roughly where the limit is reached",
+                        setup)
         found = float(last.limit[1]) if last.limit else None
     except (SimulationError, CaseError):
         found = None
@@ -459,7 +497,8 @@ def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0,
     reach = g.limits.reach_x
     if hertz.half_width_x >= reach:
         problems.append(("loading.normal_load", f"the unworn contact alone (Hertz half-width {hertz.half_width_x:.4g} "
-                                                f"mm under {case.normal_load:.4g} N) reaches beyond {reach:.4g} mm, "
+                                                f"mm and peak pressure p0 = {hertz.peak_pressure:.4g} MPa under "
+                                                f"{case.normal_load:.4g} N) reaches beyond {reach:.4g} mm, "
                                                 f"half the body's radius, where its paraboloid (Eqs. 9–10) stops "
                                                 f"describing it: no elastic contact model holds; check the load "
                                                 f"and the radius and their units"))
@@ -471,6 +510,13 @@ def prepare(case: Case, allow_unstable: bool = False, _refine: float = 1.0,
                              f"contact modulus E* = {e_star:.4g} MPa: well beyond the yield of the softer body for "
                              f"any metal (hardened bearing steel stays elastic to about 4 GPa, 3.5 % of its E*); the "
                              f"elastic model is out of its range, check the load and the moduli")
+    onset = YIELD_ONSET["line" if hertz.line else "point"]
+    for body, m in (("moving", case.moving), ("stationary", case.stationary)):
+        if m.yield_strength is not None and hertz.peak_pressure > onset * m.yield_strength:
+            plan.warnings.append(f"the Hertz peak pressure p0 = {hertz.peak_pressure:.4g} MPa passes the onset of "
+                                 f"yield in the {body} body ({onset:g} × its yield strength {m.yield_strength:.4g} MPa "
+                                 f"= {onset * m.yield_strength:.4g} MPa for a {'line' if hertz.line else 'point'} "
+                                 f"contact): it yields below the surface, where the elastic model does not follow it")
     if hertz.half_width_x > SMALL_CONTACT * reach * 2:
         plan.warnings.append(f"the Hertz half-width a = {hertz.half_width_x:.4g} mm is {hertz.half_width_x / (2 * reach):.0%}"
                              f" of the radius: the half-space model assumes a ≪ R (beyond about "
@@ -869,7 +915,7 @@ def _check_model_growth(case: Case, gap_model: str, spectrum: Spectrum, plan: Pl
                                                     f"e^{growth:.0f} over the run. Use model.gap: auto (or "
                                                     f"stroke_average), which is stable")])
     plan.warnings.append(f"the mid-stroke gap model is unstable here (growth rate {rate:.3g} per cycle), but "
-                         f"over {case.cycles} cycles a seed grows at most e^{growth:.1f}-fold")
+                         f"over {case.cycles} cycles a seed grows at most by a factor {math.exp(growth):.3g}")
 
 
 def _show(value: Any) -> str:

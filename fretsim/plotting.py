@@ -13,6 +13,7 @@ import math
 import os
 import threading
 from pathlib import Path
+from typing import Optional
 
 import matplotlib
 
@@ -144,6 +145,13 @@ def figures(res: Results, log_cycles: bool = False, names=None) -> dict:
     return out
 
 
+def _savefig(fig, path, dpi: int, fmt: Optional[str] = None) -> None:
+    """fig.savefig; a PNG with zlib's fastest level: a third of a figure's time was the default level's
+    compression, for files 8 % smaller (measured on a 3D run's four figures)."""
+    fmt = fmt or Path(path).suffix.lstrip(".") or "png"
+    fig.savefig(path, dpi=dpi, format=fmt, **({"pil_kwargs": {"compress_level": 1}} if fmt == "png" else {}))
+
+
 # figures drawn by the forked helper: together about as long to render as the others (measured on a 3D file)
 _FORKED = ("wear_profiles", "maps", "fretting")
 
@@ -167,7 +175,7 @@ def plot_all(res: Results, outdir: str | Path, fmt: str = "png", dpi: int = 150,
             # a figure appears whole or not at all: a full disk never leaves a truncated one over a good one
             tmp = outdir / f".{paths[name].name}.{os.getpid()}.tmp"
             try:
-                fig.savefig(tmp, dpi=dpi, format=fmt)
+                _savefig(fig, tmp, dpi, fmt)
                 os.replace(tmp, paths[name])
             finally:
                 plt.close(fig)
@@ -254,7 +262,7 @@ def plot_overlay(results: list, outdir: str | Path, expected: bool = False, fmt:
     tmp = outdir / f".overlay.{os.getpid()}.tmp"
     fig = overlay(results, expected)
     try:
-        fig.savefig(tmp, dpi=dpi, format=fmt)
+        _savefig(fig, tmp, dpi, fmt)
         os.replace(tmp, path)
     finally:
         plt.close(fig)
@@ -288,7 +296,7 @@ def published_profiles(panels: list, path: str | Path) -> Path:
     fig.tight_layout()
     tmp = path.with_name(f".{path.name}.{os.getpid()}.tmp")
     try:
-        fig.savefig(tmp, dpi=110, format="png")
+        _savefig(fig, tmp, 110, "png")
         os.replace(tmp, path)
     finally:
         plt.close(fig)
@@ -598,7 +606,7 @@ def plot_sweep(table: SweepTable, outdir: str | Path, fmt: str = "png", dpi: int
         fig.suptitle(f"{Path(table.path).name}: response to {axis}", fontsize=10)
         fig.tight_layout()
         path = outdir / f"sweep_{axis.replace('.', '_')}.{fmt}"
-        fig.savefig(path, dpi=dpi)
+        _savefig(fig, path, dpi)
         plt.close(fig)
         paths.append(path)
     return paths
@@ -652,7 +660,7 @@ def uncertainty_bands(table: SweepTable, outdir: Path, fmt: str = "png", dpi: in
                  fontsize=9)
     fig.tight_layout()
     path = outdir / f"uncertainty_depth_band.{fmt}"
-    fig.savefig(path, dpi=dpi)
+    _savefig(fig, path, dpi)
     plt.close(fig)
     paths.append(path)
     reached = [r for r in table.rows if r.get("status") == "complete" and r.get("limit_reached")]
@@ -685,7 +693,7 @@ def uncertainty_bands(table: SweepTable, outdir: Path, fmt: str = "png", dpi: in
                      + (f" ({not_reached} samples did not reach it)" if not_reached else ""), fontsize=10)
         fig.tight_layout()
         path = outdir / f"uncertainty_time_to_limit.{fmt}"
-        fig.savefig(path, dpi=dpi)
+        _savefig(fig, path, dpi)
         plt.close(fig)
         paths.append(path)
     return paths
@@ -713,6 +721,6 @@ def grouped_bars(labels: list[str], panels: dict, path: str | Path, title: str, 
     axes[0][0].legend(fontsize=8)
     fig.suptitle(title)
     fig.tight_layout()
-    fig.savefig(path, dpi=dpi)
+    _savefig(fig, path, dpi)
     plt.close(fig)
     return Path(path)

@@ -130,7 +130,7 @@ SUMMARY_UNITS = {
     "dissipated_energy_per_cycle_J": "J", "stick_half_width_x_mm": "mm", "gross_slip_stroke_um": "um",
     "estimated_error_depth": "1", "estimated_error_width": "1", "estimated_error_pressure": "1",
     "estimated_error_max_pressure": "1", "limit_reached": "", "cycles_to_limit": "cycles", "time_to_limit_h": "h",
-    "estimated_error_cycles_to_limit": "1",
+    "estimated_error_cycles_to_limit": "1", "grid_error_wall_time_s": "s",
 }
 # NaN in 2D; infinite when nothing wears; unknown without a friction coefficient
 NAN_SUMMARY = {"element_size_y_um", "stability_limit_linear", "tangential_force_amplitude_N",
@@ -391,77 +391,71 @@ class ResultsWriter:
     def _write(self, f: h5py.File) -> None:
         grid = self.grid
         text = h5py.string_dtype()
-        f.attrs.update(format_version=FORMAT_VERSION, fretsim_version=__version__, status=self.status,
-                       status_message=self.message, case_name=self.case_name, notes="\n".join(self.notes),
-                       input_sha256=self.input_sha256)
-        c = f.create_dataset("case", data=self.case_yaml, dtype=text)
-        c.attrs["sha256"] = hashlib.sha256(self.case_yaml.encode()).hexdigest()
-        c.attrs["long_name"] = "the validated case with every default and automatic choice filled (YAML)"
-        self._write_inputs(f)
-        ch = f.create_group("choices")
-        ch.create_dataset("key", data=[c.key for c in self.choices], dtype=text)
-        ch.create_dataset("value", data=[_value_text(c.value) for c in self.choices], dtype=text)
-        ch.create_dataset("reason", data=[c.reason for c in self.choices], dtype=text)
-        ch.create_dataset("given", data=np.array([c.given for c in self.choices], dtype=np.int8))
-        g = f.create_group("grid")
+        w = _SealingWriter(f)
+        w.attrs(f, format_version=FORMAT_VERSION, fretsim_version=__version__, status=self.status,
+                status_message=self.message, case_name=self.case_name, notes="\n".join(self.notes),
+                input_sha256=self.input_sha256)
+        w.dataset(f, "case", self.case_yaml, text,
+                  long_name="the validated case with every default and automatic choice filled (YAML)")
+        self._write_inputs(w, f)
+        ch = w.group(f, "choices")
+        w.dataset(ch, "key", [c.key for c in self.choices], text)
+        w.dataset(ch, "value", [_value_text(c.value) for c in self.choices], text)
+        w.dataset(ch, "reason", [c.reason for c in self.choices], text)
+        w.dataset(ch, "given", np.array([c.given for c in self.choices], dtype=np.int8))
+        g = w.group(f, "grid")
         for name, values in (("x", grid.x), ("y", grid.y)):
-            ds = g.create_dataset(name, data=values)
-            ds.attrs.update(units="mm", long_name=f"element centre, {'sliding direction' if name == 'x' else 'across it'}")
-        g.attrs.update(dx_mm=grid.dx, dy_mm=grid.dy, plane_strain=np.int8(grid.plane_strain))
-        h = f.create_group("history")
+            w.dataset(g, name, values, units="mm",
+                      long_name=f"element centre, {'sliding direction' if name == 'x' else 'across it'}")
+        w.attrs(g, dx_mm=grid.dx, dy_mm=grid.dy, plane_strain=np.int8(grid.plane_strain))
+        h = w.group(f, "history")
         n = len(self.rows)
         rows = np.array(self.rows, dtype=float).reshape(n, len(HISTORY))
-        step = h.create_dataset("step", data=np.arange(n, dtype="i8"))
+        step = w.dataset(h, "step", np.arange(n, dtype="i8"), units="1", long_name="accepted step")
         step.make_scale("step")
-        step.attrs.update(units="1", long_name="accepted step")
         for j, (name, (units, long_name, _)) in enumerate(HISTORY.items()):
             data = rows[:, j].astype("i8") if name in INTEGER_HISTORY else rows[:, j]
-            ds = h.create_dataset(name, data=data)
-            ds.attrs.update(units=units, long_name=long_name)
+            extra = {} if name == "cycle" else {"coordinates": "cycle"}
+            ds = w.dataset(h, name, data, units=units, long_name=long_name, **extra)
             ds.dims[0].attach_scale(step)
-            if name != "cycle":
-                ds.attrs["coordinates"] = "cycle"
-        fl = f.create_group("fields")
+        fl = w.group(f, "fields")
         ny, nx = grid.shape
-        cyc = fl.create_dataset("cycle", data=np.array(self.field_cycles, dtype="i8"))
+        cyc = w.dataset(fl, "cycle", np.array(self.field_cycles, dtype="i8"), units="cycles",
+                        long_name="cycle number of the snapshot")
         cyc.make_scale("cycle")
-        cyc.attrs.update(units="cycles", long_name="cycle number of the snapshot")
         scales = [cyc]
         for name, values in (("y", grid.y), ("x", grid.x)):
-            ds = fl.create_dataset(name, data=values)
+            ds = w.dataset(fl, name, values, units="mm",
+                           long_name=f"element centre, {'sliding direction' if name == 'x' else 'across it'}")
             ds.make_scale(name)
-            ds.attrs.update(units="mm", long_name=f"element centre, {'sliding direction' if name == 'x' else 'across it'}")
             scales.append(ds)
         for name, (units, long_name, _) in FIELDS.items():
             data = np.array(self.fields[name]).reshape(len(self.fields[name]), ny, nx)
-            ds = fl.create_dataset(name, data=data)
-            ds.attrs.update(units=units, long_name=long_name)
+            ds = w.dataset(fl, name, data, units=units, long_name=long_name)
             for axis, scale in enumerate(scales):
                 ds.dims[axis].attach_scale(scale)
-        lp = f.create_group("fretting_loop")
-        lp.attrs["long_name"] = ("the fretting loop at each snapshot: the rig's displacement and the tangential "
-                                 "force round one cycle (−δ → +δ → −δ); no points for uniform slip")
-        lcyc = lp.create_dataset("cycle", data=np.array(self.field_cycles, dtype="i8"))
+        lp = w.group(f, "fretting_loop")
+        w.attrs(lp, long_name="the fretting loop at each snapshot: the rig's displacement and the tangential "
+                              "force round one cycle (−δ → +δ → −δ); no points for uniform slip")
+        lcyc = w.dataset(lp, "cycle", np.array(self.field_cycles, dtype="i8"), units="cycles",
+                         long_name="cycle number of the snapshot")
         lcyc.make_scale("cycle")
-        lcyc.attrs.update(units="cycles", long_name="cycle number of the snapshot")
         points = max((len(u) for u, _ in self.loops), default=0)
         for name, k, units, long_name in (("displacement", 0, "um", "the rig's tangential displacement"),
                                           ("tangential_force", 1, "N", "the tangential force Q (total)")):
             data = np.full((len(self.loops), points), np.nan)
             for i, pair in enumerate(self.loops):
                 data[i, :len(pair[k])] = pair[k]
-            ds = lp.create_dataset(name, data=data)
-            ds.attrs.update(units=units, long_name=long_name)
+            ds = w.dataset(lp, name, data, units=units, long_name=long_name)
             ds.dims[0].attach_scale(lcyc)
-        s = f.create_group("summary")
+        s = w.group(f, "summary")
         for key, value in self.summary.items():
-            s.attrs[key] = value
-            ds = s.create_dataset(key, data=value)
-            ds.attrs.update(units=SUMMARY_UNITS.get(key, "1"), long_name=_long_name(key))
+            w.dataset(s, key, value, units=SUMMARY_UNITS.get(key, "1"), long_name=_long_name(key))
+        w.attrs(s, **self.summary)
         if self.summary:
-            s.attrs["units"] = ", ".join(f"{k}: {SUMMARY_UNITS.get(k, '1')}" for k in self.summary)
-        if self.state is not None:
-            c = f.create_group("checkpoint")
+            w.attrs(s, units=", ".join(f"{k}: {SUMMARY_UNITS.get(k, '1')}" for k in self.summary))
+        if self.state is not None:  # not sealed: it carries its own digest (but the root names it)
+            c = w.unsealed_group(f, "checkpoint")
             for key, value in self.state.items():
                 if isinstance(value, np.ndarray):
                     c.create_dataset(key, data=value)
@@ -470,16 +464,15 @@ class ResultsWriter:
                 elif value is not None:
                     c.attrs[key] = value
             c.attrs["sha256"] = _checkpoint_digest(self.state)
-        _seal(f)
+        w.seal()
 
-    def _write_inputs(self, f: h5py.File) -> None:
-        g = f.create_group("inputs")
+    def _write_inputs(self, w: "_SealingWriter", f: h5py.File) -> None:
+        g = w.group(f, "inputs")
         for key, (value, units, long_name) in self.inputs.get("values", {}).items():
-            ds = g.create_dataset(key, data=value if not isinstance(value, str) else value,
-                                  dtype=h5py.string_dtype() if isinstance(value, str) else None)
-            ds.attrs.update(units=units, long_name=long_name)
-        g.attrs["overrides"] = json.dumps(list(self.inputs.get("overrides", [])))
-        g.attrs["case_file"] = str(self.inputs.get("case_file", ""))
+            w.dataset(g, key, value, h5py.string_dtype() if isinstance(value, str) else None, units=units,
+                      long_name=long_name)
+        w.attrs(g, overrides=json.dumps(list(self.inputs.get("overrides", []))),
+                case_file=str(self.inputs.get("case_file", "")))
 
 
 # --- checksums: every dataset and every group's attributes carry a sha256 of what was written ----------------------
@@ -551,6 +544,155 @@ def _verify_seal(f) -> None:
         if _attrs_digest(obj) != _text(obj.attrs["attrs_sha256"]):
             raise _Damaged(f"{where or '/'}: its attributes{'' if isinstance(obj, h5py.Dataset) else ' or the names it holds'}"
                            f" do not match their checksum (changed since it was written)")
+
+
+class _SealingWriter:
+    """Creates the sealed groups and datasets of a file and seals them from the values it was given, without
+    reading the file back (which cost most of a flush).  Each value is taken in the form HDF5 gives it back (a
+    Python float as numpy.float64, a text list as bytes), so the seal is the one :func:`_seal` would compute and
+    :func:`_verify_seal` checks; an object created past this writer is left unsealed and the reader refuses it."""
+
+    def __init__(self, f: h5py.File):
+        self._objects = {"/": f}
+        self._attrs = {"/": {}}
+        self._members = {"/": []}
+        self._digests = {}
+
+    def group(self, parent, name: str, **attrs):
+        g = parent.create_group(name)
+        self._enter(parent, g, name)
+        self.attrs(g, **attrs)
+        return g
+
+    def dataset(self, parent, name: str, data, dtype=None, **attrs):
+        ds = _new_dataset(parent, name, data, dtype)
+        self._enter(parent, ds, name)
+        self._digests[ds.name] = _given_digest(data, dtype)
+        self.attrs(ds, **attrs)
+        return ds
+
+    def attrs(self, obj, **attrs) -> None:
+        given = self._attrs[obj.name]
+        for key, value in attrs.items():
+            if key in given:
+                del obj.attrs[key]
+            _new_attr(obj, key, value)
+            given[key] = _as_read(value)
+
+    def unsealed_group(self, parent, name: str):
+        self._members[parent.name].append(name)
+        return parent.create_group(name)
+
+    def seal(self) -> None:
+        for name, obj in self._objects.items():
+            if name in self._digests:
+                _new_attr(obj, "sha256", self._digests[name])
+            _new_attr(obj, "attrs_sha256", _digest_of_attrs(self._attrs[name], self._members.get(name)))
+
+    def _enter(self, parent, obj, name: str) -> None:
+        self._objects[obj.name] = obj
+        self._attrs[obj.name] = {}
+        self._members[parent.name].append(name)
+        if isinstance(obj, h5py.Group):
+            self._members[obj.name] = []
+
+
+_TEXT = h5py.string_dtype()
+_HTYPES: dict = {}
+
+
+def _types(key) -> tuple:
+    """The HDF5 file and memory types h5py makes for a numpy dtype (or "text": variable-length UTF-8), made once."""
+    if key not in _HTYPES:
+        dtype = _TEXT if key == "text" else key
+        _HTYPES[key] = (h5py.h5t.py_create(dtype, logical=True), h5py.h5t.py_create(dtype))
+    return _HTYPES[key]
+
+
+def _space(shape: tuple):
+    if shape:
+        return h5py.h5s.create_simple(shape)
+    if "scalar" not in _HTYPES:
+        _HTYPES["scalar"] = h5py.h5s.create(h5py.h5s.SCALAR)
+    return _HTYPES["scalar"]
+
+
+def _new_attr(obj, name: str, value) -> None:
+    """obj.attrs[name] = value for a name not yet there, by HDF5's own calls: the same attribute h5py writes
+    (a text as variable-length UTF-8, a number or numeric array by its numpy type) at a third of the cost."""
+    if isinstance(value, str):
+        data, key = np.array(value, dtype=_TEXT), "text"
+    else:
+        data = np.asarray(value)
+        key = data.dtype
+        if data.dtype.kind not in "biuf":
+            obj.attrs[name] = value
+            return
+    logical, memory = _types(key)
+    attr = h5py.h5a.create(obj.id, name.encode(), logical, _space(data.shape))
+    try:
+        attr.write(data, mtype=memory)
+    finally:
+        attr.close()
+
+
+def _new_dataset(parent, name: str, data, dtype=None):
+    """parent.create_dataset(name, data=data, dtype=dtype) by HDF5's own calls for the contiguous text and
+    numeric datasets of this layout (h5py's general path cost half a flush); anything else goes through h5py."""
+    if isinstance(data, str) or (dtype is not None and h5py.check_string_dtype(dtype) is not None):
+        array, key = np.array(data, dtype=_TEXT), "text"
+    else:
+        array = np.asarray(data, dtype=dtype)
+        key = array.dtype
+        if array.dtype.kind not in "biuf":
+            return parent.create_dataset(name, data=data, dtype=dtype)
+    logical, memory = _types(key)
+    space = _space(array.shape)
+    dset = h5py.h5d.create(parent.id, name.encode(), logical, space)
+    if array.size:
+        dset.write(h5py.h5s.ALL, h5py.h5s.ALL, np.ascontiguousarray(array), mtype=memory)
+    return h5py.Dataset(dset)
+
+
+def _as_read(value):
+    """An attribute's value as h5py reads it back."""
+    if isinstance(value, str):
+        return str(value)
+    if isinstance(value, (bool, np.bool_)):
+        return np.bool_(value)
+    if isinstance(value, int):
+        return np.int64(value)
+    if isinstance(value, float):
+        return np.float64(value)
+    if isinstance(value, (np.number, np.ndarray)):
+        return value
+    raise TypeError(f"an attribute of type {type(value).__name__} is not sealed by value")
+
+
+def _given_digest(data, dtype) -> str:
+    """_value_digest of a dataset's value as read back, from the value it was created with."""
+    if isinstance(data, str):
+        return _value_digest(data)
+    if dtype is not None and h5py.check_string_dtype(dtype) is not None:
+        return _value_digest(np.array([v.encode() for v in data], dtype=object).reshape(len(data)))
+    a = np.asarray(data, dtype=dtype)
+    if a.dtype.kind in "OUS":
+        raise TypeError("text datasets are written with a string dtype")
+    return _value_digest(a)
+
+
+def _digest_of_attrs(attrs: dict, members: Optional[list]) -> str:
+    """_attrs_digest of an object from the attributes given to it (as read back) and, for a group, its members."""
+    h = hashlib.sha256()
+    if members is not None:
+        h.update(("members:" + "\0".join(sorted(members)) + "\0").encode())
+    for k in sorted(k for k in attrs if k not in _SCALE_ATTRS):
+        v = attrs[k]
+        h.update(k.encode() + b"=")
+        h.update(v if isinstance(v, bytes) else _value_digest(v).encode() if isinstance(v, np.ndarray) else
+                 repr(v).encode())
+        h.update(b"\0")
+    return h.hexdigest()
 
 
 def _fsync_dir(directory: Path) -> None:

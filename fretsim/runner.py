@@ -242,7 +242,9 @@ def _execute(setup, filled, plan, output, overwrite, progress, observers, resume
         raise
     if status == "complete" and counter.last is not None:
         try:
+            started = time.perf_counter()
             counter.extra = _error_estimates(setup, filled, plan, counter)
+            counter.extra["grid_error_wall_time_s"] = time.perf_counter() - started
         except KeyboardInterrupt:
             previous = _ignore_signals()
             try:
@@ -303,14 +305,15 @@ def _summary(setup, counter, t0) -> dict:
     if counter.last is None:
         return {}
     out = summarize(setup, counter.last, counter.solves, _elapsed(counter, t0), counter.errors)
-    out.update(counter.extra or {k: float("nan") for k in grid_error.KEYS + (grid_error.LIMIT_KEY,)})
+    out.update(counter.extra or {**{k: float("nan") for k in grid_error.KEYS + (grid_error.LIMIT_KEY,)},
+                                 "grid_error_wall_time_s": 0.0})
     return out
 
 
 def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter") -> dict:
     """The total error estimates of the reported numbers: the stepping's, the grid's (from a companion run on a
     grid twice as coarse, see :mod:`fretsim.grid_error`) and the model difference ``auto`` accepted."""
-    from fretsim.plan import _announce, prepare as prepare_case
+    from fretsim.plan import prepare as prepare_case, side_run
     summary = summarize(setup, counter.last, counter.solves, 0.0, counter.errors)
     model_part = sum(c.error for c in plan.choices)
     if filled.grid_error == "none" or filled.cycles == 0 or filled.elements is None:
@@ -319,9 +322,8 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
     companion = grid_error.companion_case(filled, line_contact)
     try:
         c_setup, _, _ = prepare_case(companion)
-        _announce(f"grid error: the case again on a grid twice as coarse ({c_setup.grid.shape[1]} × "
-                  f"{c_setup.grid.shape[0]} elements) to estimate the grid's part of the error")
-        last = simulate(c_setup)
+        last = side_run(f"grid error: the case again on a grid twice as coarse ({c_setup.grid.shape[1]} × "
+                        f"{c_setup.grid.shape[0]} elements) to estimate the grid's part of the error", c_setup)
     except (SimulationError, CaseError) as exc:  # e.g. the mid-stroke gap, stable on the run's grid, is not on
         #                                           the coarser one: the run stands, its grid error is unknown
         counter.notes.append(f"the grid's error was not estimated: its companion run on a grid twice as coarse "
@@ -352,14 +354,36 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
     return out
 
 
+def estimate(setup: Setup, filled: Case) -> dict:
+    """What a run of this plan will cost besides its planning (auto's proxies, a limit's pilot: timed where they
+    run): ``solves`` and ``run_s`` of its own loop, and ``companions_s`` of its grid-error companion runs, each
+    from one timed solve on its grid (:func:`fretsim.plan.estimate_cost`)."""
+    from fretsim.plan import estimate_cost, prepare as prepare_case
+    solves, seconds = estimate_cost(setup)
+    out = {"solves": solves, "run_s": seconds, "companions_s": 0.0, "companions": 0}
+    if filled.grid_error == "none" or filled.cycles == 0 or filled.elements is None:
+        return out
+    line_contact = setup.y_edges_free and not setup.grid.plane_strain
+    for times in (1, 2):
+        try:
+            c_setup, _, _ = prepare_case(grid_error.companion_case(filled, line_contact, times=times))
+        except (SimulationError, CaseError):
+            continue
+        out["companions_s"] += estimate_cost(c_setup)[1]
+        out["companions"] += 1
+    return out
+
+
 def _coarsest(filled: Case, line_contact: bool) -> Optional[dict]:
     """The summary of the run on a grid four times as coarse (whether the peak pressure converges), or None where
     that grid cannot carry the run (too few elements for the contact, an unstable gap): the peak is then read
     from two grids."""
-    from fretsim.plan import prepare as prepare_case
+    from fretsim.plan import prepare as prepare_case, side_run
     try:
         c_setup, _, _ = prepare_case(grid_error.companion_case(filled, line_contact, times=2))
-        return summarize(c_setup, simulate(c_setup), 0, 0.0)
+        return summarize(c_setup, side_run(f"grid error: the case again on a grid four times as coarse "
+                                           f"({c_setup.grid.shape[1]} × {c_setup.grid.shape[0]} elements) to see "
+                                           f"whether the peak pressure converges", c_setup), 0, 0.0)
     except (SimulationError, CaseError):
         return None
 

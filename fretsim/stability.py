@@ -22,7 +22,6 @@ from functools import lru_cache
 from typing import Optional
 
 import numpy as np
-import scipy.linalg as sla
 
 from fretsim.compliance import HalfSpace
 from fretsim.wear import stroke_symbol, wear_operator
@@ -67,7 +66,10 @@ def wear_spectrum(compliance, stroke: float, k_moving: float, k_stationary: floa
     grid = compliance.grid
     if isinstance(compliance, HalfSpace) and not general:
         theta = np.array(THETA)
-        f = _halfspace_symbol(grid.plane_strain, grid.dx, grid.dy, grid.shape[0], compliance.e_star, THETA)
+        # the kernel is homogeneous (degree 1 in lengths, -1 in E*; the 2D log's constant drops out of the second
+        # difference): one symbol per aspect ratio serves every dx and E* (a sweep's points, the companions)
+        aspect = 1.0 if grid.plane_strain else grid.dy / grid.dx
+        f = _halfspace_symbol(grid.plane_strain, 1.0, aspect, grid.shape[0], 1.0, THETA) * (grid.dx / compliance.e_star)
         b = stroke_symbol(grid.dx, stroke, theta)
         seen = {"mid_stroke": b, "stroke_average": b * b, "resolved": np.ones_like(b)}[gap_model]
         rate = 4.0 * stroke * (k_moving + k_stationary * seen)
@@ -82,6 +84,7 @@ def wear_spectrum(compliance, stroke: float, k_moving: float, k_stationary: floa
     n = c.shape[0]
     # the load fixes the mean pressure: modes live in the zero-sum subspace
     q = np.linalg.qr(np.column_stack([np.ones(n), np.eye(n)[:, :n - 1]]))[0][:, 1:]
+    import scipy.linalg as sla
     mu = sla.eigh(q.T @ w @ q, q.T @ c @ q, eigvals_only=True)
     return Spectrum(float(min(mu.min(), 0.0)), float(mu.max()), "window")
 

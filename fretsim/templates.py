@@ -37,7 +37,7 @@ def available() -> list[str]:
 def _unit(spec: Key) -> str:
     if spec.kind in INTERNAL:
         return {"length": "m, mm, um (µm), nm", "force": "N, kN, mN", "pressure": "Pa … GPa",
-                "wear_coefficient": "1/MPa, mm3/(N·m), 1/Pa, mm2/N, m2/N", "energy_wear_coefficient": "mm3/J, um3/J, m3/J",
+                "wear_coefficient": "1/MPa, mm3/(N·m), mm3/(N·mm), 1/Pa, mm2/N, m2/N", "energy_wear_coefficient": "mm3/J, um3/J, m3/J",
                 "stiffness": "N/mm, N/um, kN/mm, N/m", "frequency": "Hz, kHz, 1/min",
                 "volume": "mm3, um3, m3"}[spec.kind]
     return {"fraction": "% or a fraction", "integer": "–", "number": "–", "choice": "–", "lengths": "lengths",

@@ -21,8 +21,8 @@ UNITS: dict[str, dict[str, float]] = {
     "pressure": {"Pa": 1e-6, "kPa": 1e-3, "MPa": 1.0, "GPa": 1e3, "N/mm2": 1.0, "N/mm^2": 1.0},
     # Archard's k with the hardness in it: 1/MPa = mm²/N = mm³/(N·mm); tribologists quote the specific wear rate
     # in mm³/(N·m) (volume per load and sliding distance), a thousandth of it
-    "wear_coefficient": {"1/MPa": 1.0, "mm3/(N*m)": 1e-3, "1/Pa": 1e6, "mm2/N": 1.0, "m2/N": 1e6, "1/GPa": 1e-3,
-                         "mm^2/N": 1.0, "m^2/N": 1e6, "mm3/Nm": 1e-3, "mm3/(N*mm)": 1.0, "m3/(N*m)": 1e6},
+    "wear_coefficient": {"1/MPa": 1.0, "mm3/(N*m)": 1e-3, "mm3/(N*mm)": 1.0, "1/Pa": 1e6, "m2/N": 1e6, "mm2/N": 1.0,
+                         "1/GPa": 1e-3, "mm^2/N": 1.0, "m^2/N": 1e6, "mm3/Nm": 1e-3, "m3/(N*m)": 1e6},
     # worn volume per dissipated energy (Fouvry's α): 1 J = 1000 N·mm
     "energy_wear_coefficient": {"mm3/J": 1e-3, "mm^3/J": 1e-3, "um3/J": 1e-12, "µm3/J": 1e-12, "µm^3/J": 1e-12,
                                 "m3/J": 1e6, "m^3/J": 1e6, "mm3/Nm": 1e-3, "mm3/(N*m)": 1e-3, "mm3/(N*mm)": 1.0},

@@ -26,7 +26,6 @@ from __future__ import annotations
 from functools import lru_cache
 
 import numpy as np
-from scipy.ndimage import convolve1d
 
 from fretsim.compliance import Convolution
 from fretsim.grid import Grid
@@ -54,6 +53,7 @@ def stroke_reach(dx: float, stroke: float) -> int:
 
 def stroke_average(pressure: np.ndarray, dx: float, stroke: float) -> np.ndarray:
     """p_av of the stationary body along x (axis 1); exact for element-wise constant pressure."""
+    from scipy.ndimage import convolve1d  # at first use: planning needs none of scipy
     return convolve1d(pressure, stroke_weights(dx, stroke), axis=1, mode="constant", cval=0.0)
 
 

@@ -1,5 +1,6 @@
 """The command line: run / summary / plot, exit codes, and bad input that leaves files alone."""
 import json
+import re
 from pathlib import Path
 
 import pytest
@@ -172,5 +173,11 @@ def test_autos_proxy_runs_are_announced_and_the_estimate_counts_them():
     """With `auto`, the proxies ran silently (49 s for the tube at 10⁸ cycles) while `check` estimated 0.23 s."""
     r = CliRunner().invoke(main, ["check", str(CASES / "tube_RT.yaml"), "--set", "model.dimension=auto"])
     assert r.exit_code == 0, r.output
-    assert "model.dimension auto: a 3D proxy run" in r.output and "s of planning" in r.output
-    assert "jumping.tolerance 0.01" in r.output
+    assert "model.dimension auto: a 3D proxy run" in r.output and "jumping.tolerance 0.01" in r.output
+    # the total counts the run, its grid-error companions and the planning, which a run repeats
+    m = re.search(r"about [0-9]+ contact solves, ([0-9.]+) s for the run .*companions \(2 runs on coarser grids\) "
+                  r"about ([0-9.]+) s more; planning took ([0-9.]+) s here .*: about ([0-9.]+) s in all", r.output)
+    assert m, r.output
+    run_s, companions_s, planning_s, total_s = map(float, m.groups())
+    assert planning_s > 1.0 and companions_s > 0
+    assert total_s == pytest.approx(run_s + companions_s + planning_s, rel=0.1)  # each printed to 2 digits

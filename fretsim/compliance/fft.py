@@ -5,20 +5,48 @@ around the contact), where scipy.fft's Python layer (argument checks, padding, b
 three times the transform itself.  scipy's own pocketfft binding, called directly, skips that layer.  It is a
 private module: at import the direct path is checked against the public API on a small transform and used
 only if it exists and agrees; otherwise the public functions are used.  Both give the same numbers.
+
+scipy.fft is imported at the first transform, not with this module: `fretsim check` and `summary` need none,
+and the import is a third of a quick command's time.
 """
 from __future__ import annotations
 
 import numpy as np
-import scipy.fft as sfft
+
+
+def next_fast_len(n: int, real: bool) -> int:
+    """scipy.fft.next_fast_len for its pocketfft backend, without importing it: the smallest m ≥ n whose prime
+    factors are 2, 3 and 5 (real transforms) or 2, 3, 5, 7 and 11 (complex ones)."""
+    if n <= 6:
+        return max(n, 1)
+    best = 2 ** (n - 1).bit_length()  # a power of two ≥ n
+    primes = (3, 5) if real else (3, 5, 7, 11)
+
+    def search(m: int, i: int) -> None:
+        nonlocal best
+        for j in range(i, len(primes)):
+            k = m * primes[j]
+            while k < best:
+                search(k, j + 1)
+                p2 = k
+                while p2 < n:
+                    p2 *= 2
+                best = min(best, p2)
+                k *= primes[j]
+
+    search(1, 0)
+    return best
 
 
 def _public_forward(p: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    import scipy.fft as sfft
     ly, lx = shape
     ph = sfft.rfft(p, n=lx, axis=1, workers=1)
     return sfft.fft(ph, n=ly, axis=0, workers=1) if ly > 1 else ph
 
 
 def _public_backward(ph: np.ndarray, shape: tuple[int, int], out_shape: tuple[int, int]) -> np.ndarray:
+    import scipy.fft as sfft
     ny, nx = out_shape
     ly, lx = shape
     if ly > 1:
@@ -58,9 +86,25 @@ def _direct():
     return forward, backward
 
 
-try:
-    forward, backward = _direct()
-    DIRECT = True
-except Exception:  # noqa: BLE001 - any problem with the private binding means: use the public API
-    forward, backward = _public_forward, _public_backward
-    DIRECT = False
+def _choose() -> tuple:
+    global forward, backward, DIRECT
+    try:
+        forward, backward = _direct()
+        DIRECT = True
+    except Exception:  # noqa: BLE001 - any problem with the private binding means: use the public API
+        forward, backward = _public_forward, _public_backward
+        DIRECT = False
+    return forward, backward
+
+
+def forward(p: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
+    """p (My, Mx) zero-padded to ``shape`` and transformed: rfft along x, then fft along y."""
+    return _choose()[0](p, shape)  # the first call replaces this module's forward and backward
+
+
+def backward(ph: np.ndarray, shape: tuple[int, int], out_shape: tuple[int, int]) -> np.ndarray:
+    """Inverse of :func:`forward`, cropped to ``out_shape``."""
+    return _choose()[1](ph, shape, out_shape)
+
+
+DIRECT: bool | None = None  # known after the first transform

@@ -24,8 +24,6 @@ scripts/study_free_faces_fe.py.
 from __future__ import annotations
 
 import numpy as np
-import scipy.fft as sfft
-import scipy.linalg as sla
 
 from fretsim.compliance import fft
 from fretsim.compliance.operator import _check_dense, window_grid
@@ -143,6 +141,7 @@ class Block:
     def settlement(self, k: float, loads: np.ndarray, at: np.ndarray) -> np.ndarray:
         """Downward displacement of the top nodes ``at`` (indices along y) per load column, under cos(kx)."""
         ab = self.k[0] + k * self.k[1] + (k * k) * self.k[2]
+        import scipy.linalg as sla
         u = sla.cho_solve_banded((sla.cholesky_banded(ab, overwrite_ab=True, check_finite=False), False), loads,
                                  check_finite=False)
         return u[self.top_w[at]]
@@ -222,7 +221,8 @@ class RowConvolution:
         self.grid = grid
         self.kernel = kernel
         self.basis = basis
-        self.n_fft = sfft.next_fast_len(2 * nx - 1, real=True)
+        import scipy.fft as sfft
+        self.n_fft = fft.next_fast_len(2 * nx - 1, real=True)
         wrapped = np.zeros((r, r, self.n_fft))
         idx = (np.arange(2 * nx - 1) - (nx - 1)) % self.n_fft
         wrapped[:, :, idx] = kernel

@@ -19,7 +19,6 @@ from __future__ import annotations
 from typing import Optional
 
 import numpy as np
-import scipy.fft as sfft
 
 from fretsim.compliance import fft
 from fretsim.grid import Grid
@@ -45,16 +44,16 @@ class Convolution:
     element, centred at [My − 1, Mx − 1].
     """
 
-    def __init__(self, grid: Grid, kernel: np.ndarray, _hat: Optional[np.ndarray] = None, _parts=None):
+    def __init__(self, grid: Grid, kernel: np.ndarray, _hat=None, _parts=None):
         ny, nx = grid.shape
         if kernel.shape != (2 * ny - 1, 2 * nx - 1):
             raise ValueError(f"kernel shape {kernel.shape} does not fit the grid {grid.shape}")
         self.grid = grid
         self.kernel = kernel
         # linear (non-periodic) convolution needs at least 2M − 1 points per axis
-        self.fft_shape = (1 if ny == 1 else sfft.next_fast_len(2 * ny - 1, real=False),
-                          sfft.next_fast_len(2 * nx - 1, real=True))
-        self.hat = self._transform(kernel) if _hat is None else _hat
+        self.fft_shape = (1 if ny == 1 else fft.next_fast_len(2 * ny - 1, real=False),
+                          fft.next_fast_len(2 * nx - 1, real=True))
+        self._hat = _hat  # transformed at first use: planning (`fretsim check`) builds operators it never applies
         self.n_applications = 0
         self._parts = _parts or ((1.0, self),)  # a sum remembers its terms, whose windows are cached
         self._windows: dict = {}
@@ -67,7 +66,17 @@ class Convolution:
     def convolution(self) -> "Convolution":
         return self
 
+    @property
+    def hat(self) -> np.ndarray:
+        """The kernel's Fourier symbol on the padded grid."""
+        if self._hat is None:
+            self._hat = self._transform(self.kernel)
+        elif callable(self._hat):  # a sum or a scaling: of its terms' symbols, as if made at once
+            self._hat = self._hat()
+        return self._hat
+
     def _transform(self, kernel: np.ndarray) -> np.ndarray:
+        import scipy.fft as sfft
         ny, nx = self.grid.shape
         ly, lx = self.fft_shape
         wrapped = np.zeros(self.fft_shape)
@@ -135,12 +144,12 @@ class Convolution:
         if other.grid is not self.grid and (other.grid.shape != self.grid.shape or other.grid.dx != self.grid.dx):
             raise ValueError("convolutions on different grids cannot be added")
         parts = self._parts + tuple((scale * c, op) for c, op in other._parts)
-        return Convolution(self.grid, self.kernel + scale * other.kernel, self.hat + scale * other.hat, parts)
+        return Convolution(self.grid, self.kernel + scale * other.kernel, lambda: self.hat + scale * other.hat, parts)
 
 
 def scaled(op: Convolution, scale: float) -> Convolution:
     """scale·op, sharing nothing but the cached windows of op's terms."""
-    return Convolution(op.grid, scale * op.kernel, scale * op.hat, tuple((scale * c, o) for c, o in op._parts))
+    return Convolution(op.grid, scale * op.kernel, lambda: scale * op.hat, tuple((scale * c, o) for c, o in op._parts))
 
 
 class Matrix:

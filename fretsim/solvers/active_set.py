@@ -14,7 +14,6 @@ from __future__ import annotations
 from typing import Optional
 
 import numpy as np
-import scipy.linalg as sla
 
 from fretsim.solvers.result import ContactResult, complementarity_residual
 
@@ -53,6 +52,7 @@ def solve_active_set(compliance, gap: np.ndarray, load: float, p0: Optional[np.n
     alpha = 0.0
     success = False
     message = ""
+    import scipy.linalg as sla
     for it in range(1, max_iter + 1):
         s = np.flatnonzero(active)
         k = s.size

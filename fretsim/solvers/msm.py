@@ -33,7 +33,6 @@ from __future__ import annotations
 from typing import Optional
 
 import numpy as np
-import scipy.linalg as sla
 
 from fretsim.solvers.result import ContactResult, complementarity_residual
 
@@ -193,6 +192,7 @@ class _Basis:
         return out
 
     def _factor(self) -> None:
+        import scipy.linalg as sla
         rows = np.asarray(self.t_rows)
         self._rows = rows
         self._r_rows = np.flatnonzero(self.y_basic)
@@ -222,6 +222,7 @@ class _Basis:
 
     def dual(self) -> np.ndarray:
         """y on the T rows (zero on R rows): the Z row of B⁻¹."""
+        import scipy.linalg as sla
         e = np.zeros(len(self.nonslack))
         e[self.nonslack.index(("Z", -1))] = 1.0
         return sla.lu_solve(self._lu, e, trans=1, check_finite=False)
@@ -248,6 +249,7 @@ class _Basis:
 
     def direction(self, var):
         """B⁻¹a for the entering column: (d on non-slack basics, d on slack rows R)."""
+        import scipy.linalg as sla
         d_n = sla.lu_solve(self._lu, self._column_rows(var, self._rows), check_finite=False)
         d_r = self._column_rows(var, self._r_rows) - self._apply_rn(d_n)
         return d_n, d_r, var
