@@ -187,7 +187,8 @@ def _dimension_proxy(case: Case, e_star: float) -> tuple[float, str]:
                                   coarse_element=None, linear_jump=None, scheme="bdf2", preset=None,
                                   step_tolerance=max(case.step_tolerance, 0.03))
         out.append(_proxy(proxy, lambda setup: f"model.dimension auto: a {dim.upper()} proxy run "
-                          f"({' × '.join(map(str, elements))} elements, {case.cycles} cycles) to compare 2D with 3D"))
+                          f"({' × '.join(map(str, elements))} elements, {case.cycles} cycles, tolerance "
+                          f"{setup.step_tolerance:g}) to compare 2D with 3D"))
     diffs = {key: abs(out[1][key] / out[0][key] - 1) if out[0][key] else 0.0 for key in keys}
     worst = max(diffs, key=diffs.get)
     names = {"max_wear_depth_moving_um": "the moving body's maximum depth", "max_wear_depth_stationary_um":
@@ -331,7 +332,7 @@ def _run_proxies(case: Case, corrections: tuple, dimension: str) -> tuple[float,
                                   else case.step_tolerance, **grid)
         out.append(_proxy(proxy, lambda setup: f"model.corrections auto: a {dimension.upper()} proxy run "
                           f"{'with ' + ', '.join(corr) if corr else 'without corrections'} ({setup.grid.shape[1]} × "
-                          f"{setup.grid.shape[0]} elements, {case.cycles} cycles)"))
+                          f"{setup.grid.shape[0]} elements, {case.cycles} cycles, tolerance {setup.step_tolerance:g})"))
     diffs = {k: abs(out[1][k] / out[0][k] - 1) if out[0][k] else 0.0 for k in keys}
     worst = max(diffs, key=diffs.get)
     names = {"max_wear_depth_moving_um": "the moving body's maximum depth", "max_wear_depth_stationary_um":

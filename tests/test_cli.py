@@ -181,3 +181,65 @@ def test_autos_proxy_runs_are_announced_and_the_estimate_counts_them():
     run_s, companions_s, planning_s, total_s = map(float, m.groups())
     assert planning_s > 1.0 and companions_s > 0
     assert total_s == pytest.approx(run_s + companions_s + planning_s, rel=0.1)  # each printed to 2 digits
+
+
+def test_a_given_yield_strength_warns_where_hertz_passes_the_onset_of_yield_in_check_and_run(tmp_path):
+    # p0 = 683.6 MPa on the partial-slip ball: over 1.60 σ_y (point contact) for σ_y = 400 MPa, not for 450 MPa
+    case = str(CASES / "ball_partial_slip.yaml")
+    r = CliRunner().invoke(main, ["check", case, "--set", "materials.stationary.yield_strength=400 MPa"])
+    assert r.exit_code == 0 and "warning: the Hertz peak pressure p0 = 683.6 MPa passes the onset of yield in the " \
+        "stationary body (1.6 × its yield strength 400 MPa = 640 MPa" in r.output, r.output
+    assert "yield_strength: 400 MPa" in r.output  # kept in the filled case
+    r = CliRunner().invoke(main, ["check", case, "--set", "materials.stationary.yield_strength=450 MPa"])
+    assert r.exit_code == 0 and "onset of yield" not in r.output
+    r = CliRunner().invoke(main, ["check", case, "--set", "materials.stationary.yield_strength=400 N"])
+    assert r.exit_code == 2 and "yield_strength" in r.output and "is a force" in r.output
+    r = CliRunner().invoke(main, ["run", case, "-o", str(tmp_path / "y.h5"), "--set", "loading.cycles=10",
+                                  "--set", "materials.moving.yield_strength=0.4 GPa"])
+    assert r.exit_code == 0 and "warning: the Hertz peak pressure" in r.output and "moving body" in r.output
+
+
+def test_checks_filled_case_shows_six_significant_digits_not_binary_noise():
+    r = CliRunner().invoke(main, ["check", str(CASES / "mccoll_185N.yaml"), "--set",
+                                  "materials.stationary.wear_coefficient=3e-5 mm3/(N m)"])
+    filled = r.output.split("filled case")[1]
+    assert "wear_coefficient: 3e-08 1/MPa" in filled and "0000000" not in filled, filled
+    assert not re.search(r"\d\.\d{7,}", filled), filled
+
+
+def test_a_reader_that_goes_away_ends_the_command_quietly_with_141(tmp_path):
+    import subprocess
+    import sys
+    code = subprocess.run(f"{sys.executable} -m fretsim check {CASES / 'mccoll_185N.yaml'} --set model.dimension=2d"
+                          f" | head -c 10 > /dev/null; echo ${{PIPESTATUS[0]}}", shell=True, executable="/bin/bash",
+                          capture_output=True, text=True, cwd=tmp_path)
+    assert code.stdout.strip() == "141" and "Broken pipe" not in code.stderr and "Traceback" not in code.stderr, \
+        (code.stdout, code.stderr)
+
+
+def test_every_run_besides_the_runs_own_is_announced_and_a_proxy_is_not_run_twice(tmp_path):
+    r = CliRunner().invoke(main, ["run", str(CASES / "tube_RT.yaml"), "-o", str(tmp_path / "t.h5"), "--set",
+                                  "loading.cycles=20000"])
+    assert r.exit_code == 0, r.output
+    said = [line.split("] ", 1)[1] for line in r.output.splitlines() if line.startswith("[")]
+    assert any("twice as coarse" in s for s in said) and any("four times as coarse" in s for s in said), said
+    assert any(s.startswith("model.dimension auto") for s in said), said
+    assert len(said) == len(set(said)), said  # the dimension's proxy case has its own corrections' proxies, and says
+    #                                           so (its looser tolerance)
+    assert "grid-error companions" in r.output  # their time, beside the loop's
+
+
+def test_a_run_after_check_in_one_process_does_not_repeat_autos_proxy_runs():
+    # a notebook's check() then run(): the planning is the same, so the proxies are reused
+    import fretsim.plan as plan_module
+    from fretsim.api import check, load_case, run
+    case = load_case(CASES / "tube_RT.yaml", ["loading.cycles=20000", "grid.error_estimate=none"])
+    said: list = []
+    plan_module.announce = said.append
+    try:
+        check(case)
+        checked = len(said)
+        out = run(case)
+    finally:
+        plan_module.announce = None
+    assert checked >= 4 and len(said) == checked and out.status == "complete", said

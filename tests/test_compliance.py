@@ -1,4 +1,6 @@
 """The influence operators: closed forms, symmetry, and FFT against the dense matrix."""
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -103,3 +105,31 @@ def test_direct_fft_path_equals_the_public_scipy_api():
         assert np.abs(direct - public).max() <= ROUND_OFF * np.abs(public).max()
         back = fft_module.backward(direct, shape, p.shape)
         assert np.abs(back - fft_module._public_backward(public, shape, p.shape)).max() <= ROUND_OFF
+
+
+def test_fft_sizes_are_scipys_next_fast_len_without_importing_scipy():
+    # the padded lengths decide every convolution's round-off: they must be exactly the ones scipy would choose
+    import scipy.fft as sfft
+    rng = np.random.default_rng(4)
+    for n in [*range(1, 3000), *rng.integers(3000, 5_000_000, 400).tolist()]:
+        for real in (True, False):
+            assert fft_module.next_fast_len(n, real) == sfft.next_fast_len(n, real=real), (n, real)
+
+
+def test_planning_imports_no_fft_and_the_first_transform_does():
+    # `fretsim check` and `summary` start without scipy's FFT (a third of their time); an operator built while
+    # planning is transformed at its first use, to the same symbol as an eager transform
+    import subprocess
+    import sys
+    code = ("import sys; from fretsim.api import check, load_case; "
+            "check(load_case(sys.argv[1], ['model.dimension=2d'])); "
+            "print('scipy.fft' in sys.modules, 'scipy.linalg' in sys.modules, 'scipy.ndimage' in sys.modules)")
+    case = str(Path(__file__).resolve().parent.parent / "cases" / "mccoll_185N.yaml")
+    out = subprocess.run([sys.executable, "-c", code, case], capture_output=True, text=True, check=True).stdout
+    assert out.split() == ["False", "False", "False"], out
+    grid = Grid.centred(15, 7, 0.01, 0.2)
+    lazy = HalfSpace(grid, 1.1e5)
+    eager = Convolution(grid, lazy.kernel, lazy._transform(lazy.kernel))
+    assert np.array_equal(lazy.hat, eager.hat)
+    s = lazy.plus(wear_operator(grid, 0.025, 2e-8, 3e-8, "mid_stroke"), 300.0)
+    assert np.array_equal(s.hat, lazy.hat + 300.0 * wear_operator(grid, 0.025, 2e-8, 3e-8, "mid_stroke").hat)
