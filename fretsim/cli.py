@@ -192,7 +192,10 @@ def _side_runs(plan_module, before=lambda: None) -> list:
     def announce(what: str) -> None:
         before()
         said.append(what)
-        click.echo(f"[{time.perf_counter() - started:5.1f} s] {what}", err=True)
+        try:
+            click.echo(f"[{time.perf_counter() - started:5.1f} s] {what}", err=True)
+        except OSError:  # only information: a closed stderr must not cost the run its file
+            pass
 
     @contextlib.contextmanager
     def side_progress(setup):
@@ -234,7 +237,7 @@ class _Progress:
         self.total = setup.cycles
         self.bar = click.progressbar(length=setup.cycles, label="cycles", file=sys.stderr, show_eta=False,
                                      show_percent=True, item_show_func=self._text)
-        self.bar.__enter__()
+        self._safely(self.bar.__enter__)
 
     def _text(self, _item) -> str:
         import time
@@ -249,11 +252,19 @@ class _Progress:
             return
         self.solves += 1
         self.done += cycles
-        self.bar.update(cycles, self.done)
+        self._safely(self.bar.update, cycles, self.done)
 
     def stop(self) -> None:
         if self.bar is not None:
-            self.bar.__exit__(None, None, None)
+            bar, self.bar = self.bar, None
+            self._safely(bar.__exit__, None, None, None)
+
+    def _safely(self, call, *args) -> None:
+        """A bar is only information: a terminal that has gone (a closed pipe, a hung-up tty) turns it off rather
+        than ending the run before its file is written."""
+        try:
+            call(*args)
+        except OSError:
             self.bar = None
 
 
@@ -382,12 +393,13 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
     from fretsim.runner import estimate
     cost = estimate(setup, filled)
     total = cost["run_s"] + cost["companions_s"] + (planning if planning > 1.0 else 0.0)
-    click.echo(f"estimate: about {cost['solves']} contact solves, {_seconds(cost['run_s'])} for the run "
+    click.echo(f"estimate: about {cost['solves']} contact solves, {_duration(cost['run_s'])} for the run "
                f"(jumping.tolerance {filled.step_tolerance:g})"
-               + (f"; its grid-error companions ({cost['companions']} runs on coarser grids) about "
-                  f"{_seconds(cost['companions_s'])} more" if cost["companions"] else "")
-               + (f"; planning took {_seconds(planning)} here ({_planning_runs(said)}), which a run repeats"
-                  if planning > 1.0 else "") + f": about {_seconds(total)} in all")
+               + (f"; its grid-error companions ({cost['companions']} run{'s' if cost['companions'] > 1 else ''} "
+                  f"on coarser grids) about "
+                  f"{_duration(cost['companions_s'])} more" if cost["companions"] else "")
+               + (f"; planning took {_duration(planning)} here ({_planning_runs(said)}), which a run repeats"
+                  if planning > 1.0 else "") + f": about {_duration(total)} in all")
     click.echo("choices:")
     width = max(len(c.key) for c in plan.choices)
     for c in plan.choices:
@@ -407,13 +419,15 @@ def _planning_runs(said: list) -> str:
 
 
 def _rounded(text: str) -> str:
-    """The decimals of a text to 6 significant digits: 3.0000000000000004e-08 is 3e-08 to a reader."""
+    """A YAML text's numbers (a value, or a list item, alone or with its unit) to 6 significant digits:
+    3.0000000000000004e-08 is 3e-08 to a reader.  Names and paths are left as written."""
     import re
-    return re.sub(r"(?<![\w.])-?\d+\.\d+(?:e[-+]?\d+)?(?![\w.])", lambda m: f"{float(m.group()):.6g}", text)
 
-
-def _seconds(t: float) -> str:
-    return f"{t:.2g} s" if t < 120 else f"{t / 60:.2g} min" if t < 7200 else f"{t / 3600:.2g} h"
+    def shorter(m) -> str:
+        number = m.group(2)
+        short = f"{float(number):.6g}"
+        return m.group(1) + (number if "e" in short and "e" not in number else short) + m.group(3)
+    return re.sub(r"(?m)^(\s*(?:[\w.]+: |- )(?:- )?)(-?\d+\.\d+(?:e[-+]?\d+)?)((?: [^\s:]+)?)$", shorter, text)
 
 
 def _show(value) -> str:

@@ -567,17 +567,24 @@ class _SealingWriter:
     def dataset(self, parent, name: str, data, dtype=None, **attrs):
         ds = _new_dataset(parent, name, data, dtype)
         self._enter(parent, ds, name)
-        self._digests[ds.name] = _given_digest(data, dtype)
+        try:
+            self._digests[ds.name] = _given_digest(data, dtype)
+        except TypeError:  # a value of another kind: sealed as it reads back
+            self._digests[ds.name] = _value_digest(ds[()])
         self.attrs(ds, **attrs)
         return ds
 
     def attrs(self, obj, **attrs) -> None:
         given = self._attrs[obj.name]
         for key, value in attrs.items():
-            if key in given:
+            if given is not None and key in given or given is None and key in obj.attrs:
                 del obj.attrs[key]
             _new_attr(obj, key, value)
-            given[key] = _as_read(value)
+            if given is not None:
+                try:
+                    given[key] = _as_read(value)
+                except TypeError:  # a value of another kind: this object's attributes are sealed as they read back
+                    self._attrs[obj.name] = given = None
 
     def unsealed_group(self, parent, name: str):
         self._members[parent.name].append(name)
@@ -587,7 +594,9 @@ class _SealingWriter:
         for name, obj in self._objects.items():
             if name in self._digests:
                 _new_attr(obj, "sha256", self._digests[name])
-            _new_attr(obj, "attrs_sha256", _digest_of_attrs(self._attrs[name], self._members.get(name)))
+            given = self._attrs[name]
+            _new_attr(obj, "attrs_sha256", _attrs_digest(obj) if given is None else
+                      _digest_of_attrs(given, self._members.get(name)))
 
     def _enter(self, parent, obj, name: str) -> None:
         self._objects[obj.name] = obj
@@ -648,7 +657,10 @@ def _new_dataset(parent, name: str, data, dtype=None):
             return parent.create_dataset(name, data=data, dtype=dtype)
     logical, memory = _types(key)
     space = _space(array.shape)
-    dset = h5py.h5d.create(parent.id, name.encode(), logical, space)
+    if "dcpl" not in _HTYPES:  # as h5py's: no creation and modification times, so equal runs write equal bytes
+        _HTYPES["dcpl"] = h5py.h5p.create(h5py.h5p.DATASET_CREATE)
+        _HTYPES["dcpl"].set_obj_track_times(False)
+    dset = h5py.h5d.create(parent.id, name.encode(), logical, space, dcpl=_HTYPES["dcpl"])
     if array.size:
         dset.write(h5py.h5s.ALL, h5py.h5s.ALL, np.ascontiguousarray(array), mtype=memory)
     return h5py.Dataset(dset)
@@ -664,7 +676,9 @@ def _as_read(value):
         return np.int64(value)
     if isinstance(value, float):
         return np.float64(value)
-    if isinstance(value, (np.number, np.ndarray)):
+    if isinstance(value, np.ndarray):
+        return value[()] if value.ndim == 0 else value  # h5py gives a 0-d array back as its scalar
+    if isinstance(value, np.number):
         return value
     raise TypeError(f"an attribute of type {type(value).__name__} is not sealed by value")
 

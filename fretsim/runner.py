@@ -241,10 +241,9 @@ def _execute(setup, filled, plan, output, overwrite, progress, observers, resume
             _restore_signals(previous)
         raise
     if status == "complete" and counter.last is not None:
+        started = time.perf_counter()
         try:
-            started = time.perf_counter()
             counter.extra = _error_estimates(setup, filled, plan, counter)
-            counter.extra["grid_error_wall_time_s"] = time.perf_counter() - started
         except KeyboardInterrupt:
             previous = _ignore_signals()
             try:
@@ -255,6 +254,11 @@ def _execute(setup, filled, plan, output, overwrite, progress, observers, resume
             finally:
                 _restore_signals(previous)
             raise
+        except Exception as exc:  # noqa: BLE001 - the run is complete: whatever stops its error estimate must not
+            #                                      cost it its file; the estimates are then unknown, and it says why
+            counter.notes.append(f"the grid's error was not estimated: {type(exc).__name__}: {str(exc)[:160]}")
+            counter.extra = {k: float("nan") for k in grid_error.KEYS + (grid_error.LIMIT_KEY,)}
+        counter.extra["grid_error_wall_time_s"] = time.perf_counter() - started
     previous = _ignore_signals()  # a Ctrl-C in the last instant must not make a complete run look interrupted
     try:
         _finish(writer, setup, counter, t0, status, message)

@@ -7,7 +7,7 @@ in 2D (cases/sweeps/mccoll_load_stroke.yaml, 20 points).
 * parallel efficiency: one worker against two;
 * the same sweep on a local Dask cluster (a scheduler and two worker processes on 127.0.0.1).
 
-    python scripts/bench_sweep.py [--out scripts/out]
+    python scripts/bench_sweep.py [--out scripts/out] [--vs OTHER_TREE]
 
 Prints a table and writes bench_sweep.csv.  Times are wall times of whole sweeps measured one after another in
 this process, the 1- and 2-worker sweeps in turn (best of three each); the machine is shared, so compare the
@@ -25,6 +25,7 @@ import sys
 import tempfile
 import time
 from pathlib import Path
+from typing import Optional
 
 from _study import ROOT, write_csv
 
@@ -66,6 +67,50 @@ def image_ms(sweep, tmp: Path, count: int = 5) -> float:
     return 1e3 * sum(spent) / len(spent)
 
 
+_BREAKDOWN = r"""
+import json, sys, time
+from pathlib import Path
+import fretsim.api, fretsim.runner as R, fretsim.results as RS, fretsim.simulate as SM
+from fretsim.sweep import load_sweep, run_point
+sweep = load_sweep(sys.argv[1])
+spent = {"simulations": 0.0, "flush": 0.0}
+def timed(real, key):
+    def wrapper(*a, **k):
+        t = time.perf_counter()
+        try:
+            return real(*a, **k)
+        finally:
+            spent[key] += time.perf_counter() - t
+    return wrapper
+R.simulate = SM.simulate = timed(SM.simulate, "simulations")  # the run's loop and its companions (any version)
+RS.ResultsWriter.flush = timed(RS.ResultsWriter.flush, "flush")
+def point(i, p):
+    run_point((p.name, sweep.base_text, sweep.base_source, (*sweep.shared, *p.overrides),
+               Path(sys.argv[2]) / f"{i}.h5", "run"))
+point(-1, sweep.points[0])  # warm-up
+spent.update(simulations=0.0, flush=0.0)
+t = time.perf_counter()
+for i, p in enumerate(sweep.points):
+    point(i, p)
+spent["total"] = time.perf_counter() - t
+print(json.dumps({k: 1e3 * v / len(sweep.points) for k, v in spent.items()}))
+"""
+
+
+def per_point(tree: Optional[Path], tmp: Path) -> dict:
+    """ms a point in one process (no pool): in all, in its simulations (the loop and the grid-error companions),
+    in writing its file; with ``tree``, of the fretsim in that source tree."""
+    import json
+    import os
+    env = dict(os.environ)
+    if tree is not None:
+        env["PYTHONPATH"] = str(tree) + os.pathsep + env.get("PYTHONPATH", "")
+    work = Path(tempfile.mkdtemp(dir=tmp))
+    out = subprocess.run([sys.executable, "-c", _BREAKDOWN, str(SWEEP), str(work)], env=env, cwd=tmp,
+                         capture_output=True, text=True, check=True)
+    return json.loads(out.stdout.strip().splitlines()[-1])
+
+
 def _fft_work(n: int) -> float:
     import numpy as np
     a = np.random.default_rng(0).random((256, 256))
@@ -99,10 +144,27 @@ def timed_sweep(outdir: Path, **kw) -> float:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("--out", type=Path, default=Path(__file__).resolve().parent / "out")
+    ap.add_argument("--vs", type=Path, default=None,
+                    help="another fretsim source tree (e.g. `git worktree add /tmp/prev HEAD~1`): a point's cost "
+                         "broken down for both, in turns")
     args = ap.parse_args()
     tmp = Path(tempfile.mkdtemp(prefix="bench-sweep-"))
     sweep = load_sweep(SWEEP)
-    rows = []
+    rows: list = []
+    if args.vs is not None:
+        trees = {"this": None, "other": args.vs.resolve()}
+        got: dict = {k: [] for k in trees}
+        for _ in range(2):
+            for k, tree in trees.items():
+                got[k].append(per_point(tree, tmp))
+        print("a point in one process, ms (best of 2):   in all   simulations   writing its file   overhead")
+        for k in trees:
+            best = min(got[k], key=lambda d: d["total"])
+            over = best["total"] / best["simulations"] - 1
+            print(f"  {k:5s} {'' if trees[k] is None else str(trees[k]):34s} {best['total']:7.0f} {best['simulations']:13.0f}"
+                  f" {best['flush']:18.0f} {over:10.0%}")
+            rows.append({"how": f"a point in one process, {k}", "seconds": round(best["total"] / 1e3, 4),
+                         "points": len(sweep.points), "overhead_over_work": round(over, 3)})
     # one and two workers in turn, best of three each: the machine's speed drifts from minute to minute
     ones, twos = [], []
     for _ in range(3):
@@ -148,7 +210,9 @@ def main() -> None:
                  "overhead_over_work": round(write_ms * len(sweep.points) / 1e3 / work, 3)})
     for r in rows:
         extra = (f"overhead {r['overhead_over_work']:.0%} over the simulations ({r['overhead_over_loops']:.0%} "
-                 f"over the loops alone)" if "overhead_over_loops" in r else f"{r['speed_up']:.2f}× one worker")
+                 f"over the loops alone)" if "overhead_over_loops" in r else
+                 f"overhead {r['overhead_over_work']:.0%} over the simulations" if "overhead_over_work" in r else
+                 f"{r['speed_up']:.2f}× one worker")
         secs = f"{r['seconds']:7.2f} s" if r["seconds"] == r["seconds"] else " " * 9
         print(f"  {r['how']:44s} {secs}  {extra}")
     write_csv(rows, args.out / "bench_sweep.csv")
