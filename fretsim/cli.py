@@ -410,6 +410,19 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
     click.echo("  " + _rounded(filled.to_yaml()).rstrip().replace("\n", "\n  "))
 
 
+def _points_of_sweeps(paths: tuple) -> tuple:
+    """A sweep's directory stands for its points' results files, in its table's order (as `plot DIR` draws it)."""
+    from fretsim.results import read_sweep_table
+    out: list = []
+    for path in paths:
+        if Path(path).is_dir() and (Path(path) / "table.csv").exists():
+            table = read_sweep_table(path)
+            out.extend(Path(path) / "points" / f"{row['point']}.h5" for row in table.rows)
+        else:
+            out.append(path)
+    return tuple(out)
+
+
 def _planning_runs(said: list) -> str:
     proxies = sum(w.startswith("model.") for w in said)
     pilot = any(w.startswith("wear limits") for w in said)
@@ -443,13 +456,15 @@ def _show(value) -> str:
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
 @_boundary
 def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> None:
-    """Print the summary figures of RESULTS_FILES (the /summary attributes), with the inputs of each run."""
+    """Print the summary figures of RESULTS_FILES (the /summary attributes), with the inputs of each run; a
+    sweep's directory stands for its points."""
     import json
 
     from fretsim.results import read_results, summary_json
 
     if as_json and as_csv:
         raise Fail("--json and --csv are two formats of the same figures; choose one")
+    results_files = _points_of_sweeps(results_files)
     rows, bad = [], []
     for path in results_files:
         try:

@@ -1,5 +1,6 @@
 """Sweeps (issue #10): sweep files checked like cases, long-lived workers, a table, resumable, Dask."""
 import csv
+import io
 import os
 import signal
 import subprocess
@@ -254,6 +255,16 @@ def test_a_signalled_sweep_takes_its_workers_with_it(tmp_path, sig):
         assert "interrupted" in statuses, statuses
     r = CliRunner().invoke(main, ["sweep", str(path), "-o", str(out), "--jobs", "2"])  # and it continues
     assert r.exit_code == 0, r.output
+
+
+def test_summary_of_a_sweep_directory_is_the_summary_of_its_points_in_table_order(local_sweep):
+    _, out, _ = local_sweep
+    r = CliRunner().invoke(main, ["summary", str(out), "--csv"])
+    assert r.exit_code == 0, r.output
+    rows, points = list(csv.DictReader(io.StringIO(r.output))), table(out)
+    assert [Path(x["path"]).stem for x in rows] == [p["point"] for p in points]
+    assert [float(x["centre_wear_depth_stationary_um"]) for x in rows] == \
+        pytest.approx([float(p["centre_wear_depth_stationary_um"]) for p in points], rel=1e-12)
 
 
 def test_the_same_sweep_on_a_dask_cluster_gives_the_same_table_bit_for_bit(local_sweep):
