@@ -322,8 +322,7 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
     model_part = sum(c.error for c in plan.choices)
     if filled.grid_error == "none" or filled.cycles == 0 or filled.elements is None:
         return {**grid_error.totals(summary, None, model_part), grid_error.LIMIT_KEY: float("nan")}
-    line_contact = setup.y_edges_free and not setup.grid.plane_strain
-    companion = grid_error.companion_case(filled, line_contact)
+    companion, coarsest_case = _companions(setup, filled)
     try:
         c_setup, _, _ = prepare_case(companion)
         last = side_run(f"grid error: the case again on a grid twice as coarse ({c_setup.grid.shape[1]} × "
@@ -334,7 +333,7 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
                              f"stopped ({str(exc)[:160]})")
         return {**grid_error.totals(summary, None, model_part), grid_error.LIMIT_KEY: float("nan")}
     coarse = summarize(c_setup, last, 0, 0.0)
-    coarsest = _coarsest(filled, line_contact)
+    coarsest = _coarsest(coarsest_case)
     part = grid_error.grid_estimates(summary, coarse, counter.last.pressure, setup.grid, last.pressure,
                                      c_setup.grid, coarsest)
     out = grid_error.totals(summary, part, model_part)
@@ -367,10 +366,9 @@ def estimate(setup: Setup, filled: Case) -> dict:
     out = {"solves": solves, "run_s": seconds, "companions_s": 0.0, "companions": 0}
     if filled.grid_error == "none" or filled.cycles == 0 or filled.elements is None:
         return out
-    line_contact = setup.y_edges_free and not setup.grid.plane_strain
-    for times in (1, 2):
+    for case in _companions(setup, filled):
         try:
-            c_setup, _, _ = prepare_case(grid_error.companion_case(filled, line_contact, times=times))
+            c_setup, _, _ = prepare_case(case)
         except (SimulationError, CaseError):
             continue
         out["companions_s"] += estimate_cost(c_setup)[1]
@@ -378,13 +376,20 @@ def estimate(setup: Setup, filled: Case) -> dict:
     return out
 
 
-def _coarsest(filled: Case, line_contact: bool) -> Optional[dict]:
+def _companions(setup: Setup, filled: Case) -> tuple[Case, Case]:
+    """The grid-error companions: the case on a grid twice as coarse, and four times as coarse (a line contact's
+    rows kept: its ends are where 3D differs)."""
+    line_contact = setup.y_edges_free and not setup.grid.plane_strain
+    return tuple(grid_error.companion_case(filled, line_contact, times=times) for times in (1, 2))
+
+
+def _coarsest(case: Case) -> Optional[dict]:
     """The summary of the run on a grid four times as coarse (whether the peak pressure converges), or None where
     that grid cannot carry the run (too few elements for the contact, an unstable gap): the peak is then read
     from two grids."""
     from fretsim.plan import prepare as prepare_case, side_run
     try:
-        c_setup, _, _ = prepare_case(grid_error.companion_case(filled, line_contact, times=2))
+        c_setup, _, _ = prepare_case(case)
         return summarize(c_setup, side_run(f"grid error: the case again on a grid four times as coarse "
                                            f"({c_setup.grid.shape[1]} × {c_setup.grid.shape[0]} elements) to see "
                                            f"whether the peak pressure converges", c_setup), 0, 0.0)
