@@ -172,7 +172,7 @@ def _model(case: Case, measured: Measured) -> np.ndarray:
     """The run's value of every measured datum."""
     from fretsim.limits import value
     from fretsim.runner import run
-    from fretsim.simulate import centre_line
+    from fretsim.measures import centre_line
     wall = getattr(case.geometry, "wall", None)
     obs = _Collect(measured, wall)
     out = run(case, None, observers=(obs,))

@@ -4,7 +4,7 @@ A tube is plugged when its wall has thinned past a limit, a rope retired at a lo
 depth.  ``limits:`` in a case names such quantities by the summary's names without their unit suffix
 (``max_wear_depth_stationary: 2 um``, ``wear_volume_moving: 0.01 mm3``, ``scar_width_stationary: 1 mm``) and,
 for a tube, ``wall_loss`` (its deepest wear over its wall thickness, ``40 %``).  The loop evaluates each on
-every step; when one is passed it finds the crossing cycle within the step and stops (:class:`LimitReached`).
+every step; when one is passed it finds the crossing cycle within the step and stops there.
 
 The crossing: a quantity q(N) known at the steps' cycles is interpolated through the last three (quadratic in
 N) and through the last two (linear); where their crossings differ by more than the run's tolerance the step is
@@ -18,42 +18,16 @@ from typing import Optional
 
 import numpy as np
 
-# name -> (the case's unit kind, the unit the summary reports it in, factor internal → that unit)
-LIMIT_KEYS: dict[str, tuple[str, str, float]] = {
-    "max_wear_depth_moving": ("length", "um", 1e3),
-    "max_wear_depth_stationary": ("length", "um", 1e3),
-    "centre_wear_depth_moving": ("length", "um", 1e3),
-    "centre_wear_depth_stationary": ("length", "um", 1e3),
-    "scar_width_moving": ("length", "mm", 1.0),
-    "scar_width_stationary": ("length", "mm", 1.0),
-    "wear_volume_moving": ("volume", "mm3", 1.0),
-    "wear_volume_stationary": ("volume", "mm3", 1.0),
-    "wall_loss": ("fraction", "1", 1.0),  # a tube's: its deepest wear over its wall thickness
-}
+from fretsim.quantities import WEAR, wear_value
 
-
-class LimitReached(Exception):
-    """The run reached a wear limit: it ends here, complete."""
-
-    def __init__(self, key: str, cycle: float):
-        super().__init__(f"{key} reached its limit at cycle {cycle:.6g}")
-        self.key, self.cycle = key, cycle
+# name -> (the case's unit kind, the unit the summary reports it in, factor internal → that unit): the wear
+# quantities of fretsim.quantities, which a limit may name
+LIMIT_KEYS: dict[str, tuple[str, str, float]] = {q.key: (q.kind, q.unit, q.factor) for q in WEAR.values()}
 
 
 def value(key: str, step, grid, wall: Optional[float]) -> float:
     """The quantity ``key`` at a step, in internal units (mm, mm³, fraction)."""
-    from fretsim.simulate import centre_line, scar_width
-    if key == "wall_loss":
-        return float(step.wear_moving.max()) / wall
-    body = "moving" if key.endswith("moving") else "stationary"
-    h = step.wear_moving if body == "moving" else step.wear_stationary
-    if key.startswith("max_wear_depth"):
-        return float(h.max())
-    if key.startswith("centre_wear_depth"):
-        return float(centre_line(h).max())
-    if key.startswith("scar_width"):
-        return scar_width(centre_line(h), grid.x)
-    return step.volume_moving if body == "moving" else step.volume_stationary
+    return wear_value(key, step, grid.x, wall)
 
 
 @dataclass

@@ -61,6 +61,7 @@ import numpy as np
 
 from fretsim import __version__
 from fretsim.errors import ResultsFileError
+from fretsim.quantities import SUMMARY, WEAR
 
 FORMAT_VERSION = "1.4"
 READABLE_FORMATS = ("1.1", "1.2", "1.3", "1.4")
@@ -73,12 +74,11 @@ MAX_NAME = 200  # bytes of the output's base name we accept (temporaries use fix
 # name: (units, long name, how to get the value from a Step)
 HISTORY = {
     "cycle": ("cycles", "cycle number", lambda s: s.cycle),
-    "max_wear_depth_moving": ("um", "maximum wear depth of the moving body", lambda s: s.wear_moving.max() * 1e3),
-    "max_wear_depth_stationary": ("um", "maximum wear depth of the stationary body",
-                                  lambda s: s.wear_stationary.max() * 1e3),
+    **{key: (WEAR[key].unit, WEAR[key].long_name, lambda s, q=WEAR[key]: q.measure(s, None, None) * q.factor)
+       for key in ("max_wear_depth_moving", "max_wear_depth_stationary")},
     "max_wear_depth_total": ("um", "maximum total wear depth", lambda s: (s.wear_moving + s.wear_stationary).max() * 1e3),
-    "wear_volume_moving": ("mm^3", "wear volume of the moving body", lambda s: s.volume_moving),
-    "wear_volume_stationary": ("mm^3", "wear volume of the stationary body", lambda s: s.volume_stationary),
+    **{key: ("mm^3", WEAR[key].long_name, lambda s, q=WEAR[key]: q.measure(s, None, None))
+       for key in ("wear_volume_moving", "wear_volume_stationary")},
     "max_pressure": ("MPa", "maximum contact pressure", lambda s: s.pressure.max()),
     "solver_iterations": ("1", "contact solver iterations", lambda s: s.iterations),
     "wall_time": ("s", "wall time since the start of the run", lambda s: s.wall_time),
@@ -119,25 +119,8 @@ FIELDS = {
 }
 FIELDS_V12 = [k for k in FIELDS if not k.startswith(("slip_distance", "shear"))]
 NAN_FIELDS = {"shear_traction"}  # the uniform model without a friction coefficient does not know it
-SUMMARY_UNITS = {
-    "cycles": "cycles", "contact_solves": "1", "wall_time_s": "s", "max_wear_depth_moving_um": "um",
-    "max_wear_depth_stationary_um": "um", "centre_wear_depth_moving_um": "um",
-    "centre_wear_depth_stationary_um": "um", "scar_width_stationary_mm": "mm", "scar_width_moving_mm": "mm",
-    "wear_volume_moving_mm3": "mm^3", "wear_volume_stationary_mm3": "mm^3", "archard_volume_error": "1",
-    "max_pressure_MPa": "MPa", "linear_jump": "cycles", "stability_limit_linear": "cycles",
-    "element_size_x_um": "um", "element_size_y_um": "um", "elements_x": "1", "elements_y": "1",
-    "error_estimate_depth": "1", "error_estimate_pressure": "1", "regime": "", "tangential_force_amplitude_N": "N",
-    "dissipated_energy_per_cycle_J": "J", "stick_half_width_x_mm": "mm", "gross_slip_stroke_um": "um",
-    "estimated_error_depth": "1", "estimated_error_width": "1", "estimated_error_pressure": "1",
-    "estimated_error_max_pressure": "1", "limit_reached": "", "cycles_to_limit": "cycles", "time_to_limit_h": "h",
-    "estimated_error_cycles_to_limit": "1", "grid_error_wall_time_s": "s",
-}
-# NaN in 2D; infinite when nothing wears; unknown without a friction coefficient
-NAN_SUMMARY = {"element_size_y_um", "stability_limit_linear", "tangential_force_amplitude_N",
-               "dissipated_energy_per_cycle_J", "gross_slip_stroke_um", "estimated_error_depth", "estimated_error_width",
-               "estimated_error_pressure", "estimated_error_max_pressure", "cycles_to_limit", "time_to_limit_h",
-               "estimated_error_cycles_to_limit"}  # not estimated: grid.error_estimate none,
-#                                                                            or a run that did not complete
+SUMMARY_UNITS = {key: figure.unit for key, figure in SUMMARY.items()}
+NAN_SUMMARY = {key for key, figure in SUMMARY.items() if figure.nan}
 
 
 class ResultsIOError(OSError):

@@ -22,6 +22,7 @@ from fretsim.grid import Grid
 from fretsim.jumping import (OMEGA_MAX, Q_LINEAR, THETA_LANDING, bdf2_coefficients, bdf2_local_error, next_step,
                              taylor_extrapolate, taylor_jump)
 from fretsim.loading import Loading
+from fretsim.quantities import wear_summary
 from fretsim.refine import coarsen, refine_pressure
 from fretsim.solvers import solve
 from fretsim.stability import NOISE_FLOOR, GrowthWatch, checkerboard_signed
@@ -832,49 +833,13 @@ def _record(setup: Setup, cycle: int, h_m, h_s, cyc: Cycle, work: float, t0) -> 
                 checkerboard=checkerboard_signed(res.pressure, stick=cyc.stick))
 
 
-def centre_line(field_2d: np.ndarray) -> np.ndarray:
-    """Values along y = 0: the middle row, or the mean of the two middle rows when My is even."""
-    ny = field_2d.shape[0]
-    return field_2d[ny // 2] if ny % 2 else 0.5 * (field_2d[ny // 2 - 1] + field_2d[ny // 2])
-
-
-def scar_width(profile: np.ndarray, x: np.ndarray, fraction: float = 1e-3) -> float:
-    """Width (mm) of the worn zone of a profile: where the depth exceeds ``fraction`` of its maximum.
-
-    Sub-element: the two crossings of the threshold are interpolated linearly between element centres, so
-    the width moves continuously with the grid instead of by whole elements.
-    """
-    peak = float(profile.max())
-    if peak <= 0:
-        return 0.0
-    level = fraction * peak
-    above = np.flatnonzero(profile > level)
-    i0, i1 = above[0], above[-1]
-
-    def crossing(i_in: int, i_out: int) -> float:
-        if i_out < 0 or i_out >= profile.size:
-            return float(x[i_in])
-        a, b = profile[i_out], profile[i_in]
-        return float(x[i_out] + (x[i_in] - x[i_out]) * (level - a) / (b - a))
-
-    return crossing(i1, i1 + 1) - crossing(i0, i0 - 1)
-
-
 def summarize(setup: Setup, step: Step, solves: int, wall_time: float, max_errors: tuple = (0.0, 0.0)) -> dict:
     """The /summary figures (names are a contract; see README)."""
-    h_s_c = centre_line(step.wear_stationary)
     return {
         "cycles": int(step.cycle),
         "contact_solves": int(solves),
         "wall_time_s": float(wall_time),
-        "max_wear_depth_moving_um": float(step.wear_moving.max()) * 1e3,
-        "max_wear_depth_stationary_um": float(step.wear_stationary.max()) * 1e3,
-        "centre_wear_depth_moving_um": float(centre_line(step.wear_moving).max()) * 1e3,
-        "centre_wear_depth_stationary_um": float(h_s_c.max()) * 1e3,
-        "scar_width_stationary_mm": scar_width(h_s_c, setup.grid.x),
-        "scar_width_moving_mm": scar_width(centre_line(step.wear_moving), setup.grid.x),
-        "wear_volume_moving_mm3": step.volume_moving,
-        "wear_volume_stationary_mm3": step.volume_stationary,
+        **wear_summary(step, setup.grid.x),
         "archard_volume_error": float(step.archard_error),
         "max_pressure_MPa": float(step.pressure.max()),
         "error_estimate_depth": float(max(step.error_depth, max_errors[0])),

@@ -125,7 +125,7 @@ def run_one(args: tuple) -> dict:
            "summary": dict(out.summary), "dimension": out.case.dimension, "overrides": list(overrides),
            "choices": [(c.key, str(c.value), c.reason) for c in (out.plan.choices if out.plan else []) if not c.given]}
     if out.last is not None and out.last.cycle > 0:  # the flat's final profile along y = 0, for the report's figure
-        from fretsim.simulate import centre_line
+        from fretsim.measures import centre_line
         row["profile_x_mm"] = out.setup.grid.x.tolist()
         row["profile_stationary_um"] = (centre_line(out.last.wear_stationary) * 1e3).tolist()
     if out.last is not None and out.last.cycle == 0:

@@ -26,7 +26,7 @@ sys.path.insert(0, str(Path(__file__).resolve().parent))
 from _study import ROOT, Report, write_csv  # noqa: E402
 
 from fretsim.api import load_case, run  # noqa: E402
-from fretsim.simulate import centre_line  # noqa: E402
+from fretsim.measures import centre_line  # noqa: E402
 
 OUT = ROOT / "scripts" / "out"
 CASES = ("mccoll_185N", "mccoll_500N", "mccoll_1670N", "mccoll_500N_10um")

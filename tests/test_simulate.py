@@ -10,7 +10,7 @@ import pytest
 from fretsim.api import run
 from fretsim.case import CaseError, load_case
 from fretsim.results import FIELDS, HISTORY, read_results
-from fretsim.simulate import centre_line
+from fretsim.measures import centre_line
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
 # Kong et al. Table 4, "current method": stationary centre-line depth (µm) and scar width (mm)
