@@ -15,12 +15,13 @@ from pathlib import Path
 from typing import Callable, Optional
 
 from fretsim.case import Case, CaseError, load_case, parse_case
+from fretsim.plan import SideRuns
 from fretsim.results import Results, read_results
 from fretsim.runner import Outcome, check, inputs_of, resume, run
 from fretsim.simulate import SimulationError
 
-__all__ = ["Case", "CaseError", "Outcome", "Results", "SimulationError", "check", "load_case", "parse_case",
-           "read_results", "run", "resume", "inputs_of", "sweep"]
+__all__ = ["Case", "CaseError", "Outcome", "Results", "SideRuns", "SimulationError", "check", "load_case",
+           "parse_case", "read_results", "run", "resume", "inputs_of", "sweep"]
 
 
 def sweep(sweep_file: str | Path, outdir: str | Path, *, jobs: int = 0, dask: Optional[str] = None,

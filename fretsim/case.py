@@ -19,21 +19,48 @@ from typing import Any, Optional
 
 import numpy as np
 
+from fretsim.cycle import CYCLES, STROKES, friction_needed
 from fretsim.errors import InputError
 from fretsim.geometry import GEOMETRIES, Geometry
+from fretsim.loading import Block, Loading, expand
+from fretsim.quantities import WEAR
 from fretsim.units import UNITS, UnitError, format_quantity, parse_quantity
+from fretsim.wear_laws import WEAR_LAWS, gross_slip_coefficients
 from fretsim.yamlread import YamlProblem, excerpt, loads, read_text
+
+
+class Names:
+    """The names a case may give for a family's members: a live view of its registry (so a member registered
+    later, a test's say, is accepted), after the words that are not members (``auto``)."""
+
+    def __init__(self, registry, extra: tuple = ()):
+        self.registry, self.extra = registry, tuple(extra)
+
+    def __iter__(self):
+        yield from self.extra
+        yield from self.registry
+
+    def __contains__(self, name) -> bool:
+        return name in self.extra or name in self.registry
+
+    def __len__(self) -> int:
+        return len(self.extra) + len(self.registry)
+
+    def __getitem__(self, i):
+        return tuple(self)[i]
+
 
 SCHEMES = ("bdf2", "implicit", "linear", "adaptive")
 # the paper's DOE optimum (section 3.1): η = 0.55, ΔN_max = 600, ΔN_L = 55
-PRESETS = {"paper": {"scheme": "adaptive", "eta": 0.55, "max": 600, "linear": 55}}
+PRESETS = {"paper": {"scheme": "adaptive", "eta": 0.55, "max": 600}}
+PRESET_LINEAR = {"paper": 55}  # a preset's ΔN_L: not filled into the case, the planner scales it to the grid
+DEFAULT_SCHEME = "bdf2"
 DIMENSIONS = ("2d", "3d", "auto")
 GAP_MODELS = ("auto", "mid_stroke", "stroke_average")
-SLIP_MODELS = ("auto", "uniform", "coulomb")
+SLIP_MODELS = Names(CYCLES, ("auto",))
 GRID_RULES = ("accuracy", "paper")
 GRID_ERRORS = ("companion", "none")
-STROKE_MODELS = ("auto", "mid_stroke", "resolved")
-WEAR_LAWS = ("archard", "energy")
+STROKE_MODELS = Names(STROKES, ("auto",))
 CORRECTIONS = ("ring_bending", "free_faces")
 MAX_CYCLES = 10**10
 LENGTH_RANGE = (1e-3, 1e4, "1 µm to 10 m")
@@ -179,7 +206,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
                       choices=STROKE_MODELS),
         "wear_law": Key("choice", "archard (dh = k·p·|ds|) or energy (dh = α·|q|·|ds|, Fouvry; needs "
                                   "materials.*.energy_wear_coefficient and loading.friction_coefficient)",
-                        "archard", choices=WEAR_LAWS),
+                        "archard", choices=Names(WEAR_LAWS)),
         "increments": Key("integer", "increments per half-stroke of the cycle (coulomb; odd: one is centred on "
                                      "mid-stroke)", 9, lo=1, hi=1001)},
     "solver": {
@@ -218,18 +245,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
 SECTIONS = ("name", "geometry", "materials", "loading", "model", "solver", "jumping", "grid", "output", "limits",
             "expected")
 # a wear limit per summary quantity (fretsim.limits): the run stops where the first is reached
-LIMITS_SCHEMA = {
-    "max_wear_depth_moving": Key("length", "the moving body's deepest wear", None),
-    "max_wear_depth_stationary": Key("length", "the stationary body's deepest wear", None),
-    "centre_wear_depth_moving": Key("length", "the moving body's deepest wear along y = 0", None),
-    "centre_wear_depth_stationary": Key("length", "the stationary body's deepest wear along y = 0", None),
-    "scar_width_moving": Key("length", "the moving body's scar width along y = 0", None),
-    "scar_width_stationary": Key("length", "the stationary body's scar width along y = 0", None),
-    "wear_volume_moving": Key("volume", "the moving body's worn volume", None),
-    "wear_volume_stationary": Key("volume", "the stationary body's worn volume", None),
-    "wall_loss": Key("fraction", "a tube's deepest wear over its wall thickness (tube_on_flat)", None, lo=1e-6,
-                     hi=1.0),
-}
+LIMITS_SCHEMA = {key: Key(q.kind, q.long_name, None, **({"lo": 1e-6, "hi": 1.0} if q.kind == "fraction" else {}))
+                 for key, q in WEAR.items()}
 BLOCK_KEYS = ("normal_load", "stroke", "cycles", "friction_coefficient")
 MAX_BLOCKS = 10_000  # blocks after repeats: each restarts the stepping (a few solves)
 
@@ -267,16 +284,7 @@ class Case:
     geometry: Geometry
     moving: Material
     stationary: Material
-    normal_load: float  # N (total)
-    stroke: float  # mm, the amplitude δ (sliding distance per cycle 4δ)
-    cycles: int
-    friction_coefficient: Optional[float] = None
-    tangential_stiffness: Optional[float] = None  # N/mm, the rig's
-    blocks: Optional[tuple] = None  # a load history: one pass of Blocks (fretsim.loading); normal_load, stroke and
-    #                                  cycles are then its largest load and stroke and its total cycles
-    repeat: int = 1  # passes of ``blocks``
-    spectrum: bool = False  # ``blocks`` came from loading.spectrum (fractions of the cycles, split in passes)
-    frequency: Optional[float] = None  # Hz
+    loading: Loading  # loads, strokes, cycles and μ: one block or a load history (fretsim.loading)
     limits: tuple = ()  # ((key, value in internal units), ...): fretsim.limits
     dimension: str = "auto"
     gap_model: str = "auto"
@@ -309,22 +317,15 @@ class Case:
     def plane_strain(self) -> bool:
         return self.dimension == "2d"
 
-    def wear_coefficients(self) -> tuple[float, float]:
-        """(moving, stationary) coefficients of p·ds in gross slip: Archard's k, or α·μ for the energy law
-        (|q| = μp wherever a point slips)."""
-        if self.wear_law == "energy":
-            mu = self.friction_coefficient
-            return self.moving.energy_wear_coefficient * mu, self.stationary.energy_wear_coefficient * mu
-        return self.moving.wear_coefficient, self.stationary.wear_coefficient
+    @property
+    def law(self):
+        """The wear law (a member of fretsim.wear_laws)."""
+        return WEAR_LAWS[self.wear_law]
 
-    def history(self) -> tuple:
-        """The loading's blocks in the order applied (repeats and spectrum passes expanded), as
-        :class:`fretsim.loading.Block`; one block for a constant loading."""
-        from fretsim.loading import Block, expand
-        if self.blocks is None:
-            return (Block(self.normal_load, self.stroke, self.cycles, self.friction_coefficient,
-                          self.tangential_stiffness),)
-        return expand(self.blocks, self.repeat, self.cycles, self.spectrum)
+    def wear_coefficients(self) -> tuple[float, float]:
+        """(moving, stationary) coefficients of p·|ds| where every point slides: Archard's k, or what the wear law
+        makes of its own (α·μ for the energy law, with the loading's μ)."""
+        return gross_slip_coefficients(self.law, self.moving, self.stationary, self.loading.friction_coefficient)
 
     def fingerprint(self) -> str:
         """sha256 of what the case asks for, as given (automatic choices unfilled; the `expected` data left out,
@@ -371,30 +372,7 @@ class Case:
         if self.coarse_element is not None:
             grid["coarse_element"] = [format_quantity(d, "length") for d in self.coarse_element]
         grid["rule"], grid["error_estimate"] = self.grid_rule, self.grid_error
-        if self.blocks is None:
-            loading = {"normal_load": format_quantity(self.normal_load, "force"),
-                       "stroke": format_quantity(self.stroke, "length"), "cycles": self.cycles}
-        else:
-            def block(b) -> dict:
-                out = {"normal_load": format_quantity(b.normal_load, "force"),
-                       "stroke": format_quantity(b.stroke, "length")}
-                out.update({"fraction": b.fraction} if self.spectrum else {"cycles": b.cycles})
-                if b.friction_coefficient is not None and b.friction_coefficient != self.friction_coefficient:
-                    out["friction_coefficient"] = b.friction_coefficient
-                return out
-            loading = {"spectrum" if self.spectrum else "blocks": [block(b) for b in self.blocks]}
-            if self.spectrum:
-                loading.update(cycles=self.cycles, repeat=self.repeat)
-            elif sum(b.cycles for b in self.blocks) * self.repeat == self.cycles:
-                loading["repeat"] = self.repeat
-            else:  # repeated up to a number of cycles, the last pass cut short
-                loading["cycles"] = self.cycles
-        if self.frequency is not None:
-            loading["frequency"] = f"{self.frequency!r} Hz"
-        if self.friction_coefficient is not None:
-            loading["friction_coefficient"] = self.friction_coefficient
-        if self.tangential_stiffness is not None:
-            loading["tangential_stiffness"] = format_quantity(self.tangential_stiffness, "stiffness")
+        loading = _loading_dict(self.loading)
         jumping = {"scheme": self.scheme, "tolerance": self.step_tolerance,
                    "linear": self.linear_jump if self.linear_jump is not None else "auto",
                    "eta": self.eta, "max": self.max_jump if self.max_jump is not None else "auto"}
@@ -426,6 +404,35 @@ class Case:
     def to_yaml(self) -> str:
         import yaml
         return yaml.safe_dump(self.to_dict(), sort_keys=False, allow_unicode=True)
+
+
+def _loading_dict(ld: Loading) -> dict:
+    """The loading section of the file layout, every dimensional value with its unit."""
+    if not ld.history:
+        b = ld.given[0]
+        loading = {"normal_load": format_quantity(b.normal_load, "force"), "stroke": format_quantity(b.stroke, "length"),
+                   "cycles": ld.cycles}
+    else:
+        def block(b) -> dict:
+            out = {"normal_load": format_quantity(b.normal_load, "force"), "stroke": format_quantity(b.stroke, "length")}
+            out.update({"fraction": b.fraction} if ld.spectrum else {"cycles": b.cycles})
+            if b.friction_coefficient is not None and b.friction_coefficient != ld.friction_coefficient:
+                out["friction_coefficient"] = b.friction_coefficient
+            return out
+        loading = {"spectrum" if ld.spectrum else "blocks": [block(b) for b in ld.given]}
+        if ld.spectrum:
+            loading.update(cycles=ld.cycles, repeat=ld.repeat)
+        elif sum(b.cycles for b in ld.given) * ld.repeat == ld.cycles:
+            loading["repeat"] = ld.repeat
+        else:  # repeated up to a number of cycles, the last pass cut short
+            loading["cycles"] = ld.cycles
+    if ld.frequency is not None:
+        loading["frequency"] = f"{ld.frequency!r} Hz"
+    if ld.friction_coefficient is not None:
+        loading["friction_coefficient"] = ld.friction_coefficient
+    if ld.tangential_stiffness is not None:
+        loading["tangential_stiffness"] = format_quantity(ld.tangential_stiffness, "stiffness")
+    return loading
 
 
 def load_case(path: str | Path, overrides: Optional[list[str]] = None) -> Case:
@@ -741,7 +748,6 @@ def _expected(spec: Key) -> str:
 
 def _read_blocks(r: "_Reader", raw_load: dict, load: dict, given: list) -> tuple[Optional[tuple], int]:
     """loading.blocks or loading.spectrum: one pass of Blocks, and the number of passes."""
-    from fretsim.loading import Block
     if len(given) > 1:
         r.fail("loading", "both blocks and spectrum given; a loading is one or the other")
         return None, 1
@@ -807,8 +813,50 @@ def _read_limits(r: "_Reader", raw: Any) -> tuple:
 
 
 def _validate(raw: dict, problems: list, source: str, default_name: str, overrides: tuple) -> Optional[Case]:
+    """The case of a parsed tree, every problem recorded in ``problems`` (None where there are any)."""
     r = _Reader(problems, source)
     r.unknown(raw, set(SECTIONS), "")
+    name = _read_name(r, raw, default_name)
+    geometry = _read_geometry(r, raw)
+    materials = _read_materials(r, raw)
+    load, blocks, repeat, spectrum = _read_loading(r, raw)
+    limits = _read_limits(r, raw.get("limits"))
+    model, solver, jumping, grid, output = (_read_section(r, raw, section)
+                                            for section in ("model", "solver", "jumping", "grid", "output"))
+    expected = raw.get("expected", {})
+    if not isinstance(expected, dict):
+        r.fail("expected", f"expected a mapping of published values, got {excerpt(expected)}")
+        expected = {}
+    scheme, preset = _scheme(jumping, raw.get("jumping") if isinstance(raw.get("jumping"), dict) else {})
+    _check_model(r, geometry, materials, model, load.get("friction_coefficient"))
+    domain = grid.get("domain")
+    stroke = load.get("stroke")
+    if domain is not None and stroke is not None and stroke >= domain[0] / 2:
+        r.fail("loading.stroke", f"the stroke amplitude {format_quantity(stroke, 'length')} is larger than half "
+                                 f"the grid's x extent ({domain[0]:.4g} mm): check its unit")
+    if problems or geometry is None:
+        if not problems:
+            r.fail("geometry", "incomplete")
+        return None
+    loading = _loading(r, load, blocks, repeat, spectrum)
+    if dict(limits).get("wall_loss") is not None and geometry.kind != "tube_on_flat":
+        r.fail("limits.wall_loss", f"a wall loss is a tube's (tube_on_flat); a {geometry.kind} has no wall: use "
+                                   f"max_wear_depth_moving")
+    if problems:
+        return None
+    return Case(name=name, geometry=geometry, moving=materials["moving"], stationary=materials["stationary"],
+                loading=loading, limits=limits, dimension=model.get("dimension"), gap_model=model["gap"],
+                corrections=model["corrections"], accuracy=model["accuracy"],
+                pressure_accuracy=model.get("pressure_accuracy"), slip=model["slip"], stroke_model=model["stroke"],
+                wear_law=model["wear_law"], increments=model["increments"], solver=solver["method"],
+                tolerance=solver["tolerance"], scheme=scheme, step_tolerance=jumping["tolerance"],
+                linear_jump=jumping.get("linear"), eta=jumping["eta"], max_jump=jumping.get("max"), preset=preset,
+                coarse_element=grid.get("coarse_element"), grid_rule=grid["rule"], grid_error=grid["error_estimate"],
+                domain=domain, elements=grid.get("elements"), snapshots=output.get("snapshots"), expected=expected,
+                overrides=overrides, source=source)
+
+
+def _read_name(r: "_Reader", raw: dict, default_name: str) -> str:
     name = raw.get("name", default_name)
     if not isinstance(name, (str, int, float)) or isinstance(name, bool):
         r.fail("name", f"expected a text, got {excerpt(name)}")
@@ -816,24 +864,31 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
     name = str(name)
     if len(name) > 200:
         r.fail("name", f"a name of {len(name)} characters; at most 200")
+    return name
 
+
+def _read_geometry(r: "_Reader", raw: dict) -> Optional[Geometry]:
+    """The geometry family's member for geometry.type, built from its keys (None, with the problems, if it cannot
+    be)."""
     geo = r.section(raw, "geometry", {"type"} | {k for keys in GEOMETRY_KEYS.values() for k in keys})
     gtype = r.key(geo, "type", SCHEMA["geometry"]["type"], "geometry.type") if geo is not None else None
-    geometry = None
-    if gtype is not None:
-        keys = GEOMETRY_KEYS[gtype]
-        for k in geo:
-            if k != "type" and k not in keys and geo[k] is not None:
-                r.fail(f"geometry.{k}", f"a {gtype} has no {k}; its keys are {', '.join(keys)}")
-        before = len(problems)
-        vals = {k: r.key(geo, k, spec, f"geometry.{k}") for k, spec in keys.items()}
-        if len(problems) == before and all(v is not None for k, v in vals.items() if keys[k].default is REQUIRED):
-            if "profile_table" in vals:  # a profile given inline or as a CSV file: one table either way
-                table = vals.pop("profile_table")
-                vals["profile"] = vals["profile"] or table
-            geometry = GEOMETRIES[gtype].from_case(
-                vals, lambda key, msg: r.fail(f"geometry.{key}" if key else "geometry", msg))
+    if gtype is None:
+        return None
+    keys = GEOMETRY_KEYS[gtype]
+    for k in geo:
+        if k != "type" and k not in keys and geo[k] is not None:
+            r.fail(f"geometry.{k}", f"a {gtype} has no {k}; its keys are {', '.join(keys)}")
+    before = len(r.problems)
+    vals = {k: r.key(geo, k, spec, f"geometry.{k}") for k, spec in keys.items()}
+    if len(r.problems) != before or any(v is None for k, v in vals.items() if keys[k].default is REQUIRED):
+        return None
+    if "profile_table" in vals:  # a profile given inline or as a CSV file: one table either way
+        table = vals.pop("profile_table")
+        vals["profile"] = vals["profile"] or table
+    return GEOMETRIES[gtype].from_case(vals, lambda key, msg: r.fail(f"geometry.{key}" if key else "geometry", msg))
 
+
+def _read_materials(r: "_Reader", raw: dict) -> dict:
     mats = r.section(raw, "materials", {"moving", "stationary"})
     materials = {}
     for body in ("moving", "stationary"):
@@ -846,105 +901,79 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
                          "energy_wear_coefficient)" if m is None else f"expected a mapping, got {excerpt(m)}")
             continue
         r.unknown(m, SCHEMA["material"], path)
-        before = len(problems)
+        before = len(r.problems)
         vals = [r.key(m, k, spec, f"{path}.{k}") for k, spec in SCHEMA["material"].items()]
-        if len(problems) == before:
+        if len(r.problems) == before:
             materials[body] = Material(*vals)
+    return materials
 
-    def read(section: str, required: bool = False, schema: Optional[dict] = None) -> dict:
-        schema = schema or SCHEMA[section]
-        mapping = r.section(raw, section, schema, required=required)
-        return {k: r.key(mapping, k, spec, f"{section}.{k}") for k, spec in schema.items()} \
-            if mapping is not None else {}
 
+def _read_section(r: "_Reader", raw: dict, section: str, required: bool = False,
+                  schema: Optional[dict] = None) -> dict:
+    """A section's keys as its schema says ({} where the section is unusable)."""
+    schema = schema or SCHEMA[section]
+    mapping = r.section(raw, section, schema, required=required)
+    return {k: r.key(mapping, k, spec, f"{section}.{k}") for k, spec in schema.items()} if mapping is not None else {}
+
+
+def _read_loading(r: "_Reader", raw: dict) -> tuple[dict, Optional[tuple], int, bool]:
+    """The loading section's keys, and a load history's blocks (one pass), passes and whether it is a spectrum."""
     raw_load = raw.get("loading") if isinstance(raw.get("loading"), dict) else {}
     given = [k for k in ("blocks", "spectrum") if raw_load.get(k) is not None]
     load_schema = SCHEMA["loading"]
     if given:  # a load history: the single load's keys are the blocks'
         relaxed = ("normal_load", "stroke") + (("cycles",) if given == ["blocks"] else ())
         load_schema = {k: (replace(v, default=None) if k in relaxed else v) for k, v in load_schema.items()}
-    load = read("loading", required=True, schema=load_schema)
+    load = _read_section(r, raw, "loading", required=True, schema=load_schema)
     blocks, repeat = _read_blocks(r, raw_load, load, given) if given else (None, 1)
-    limits = _read_limits(r, raw.get("limits"))
-    model = read("model")
-    solver = read("solver")
-    jumping_raw = raw.get("jumping") if isinstance(raw.get("jumping"), dict) else {}
-    jumping = read("jumping")
-    grid = read("grid")
-    output = read("output")
-    expected = raw.get("expected", {})
-    if not isinstance(expected, dict):
-        r.fail("expected", f"expected a mapping of published values, got {excerpt(expected)}")
-        expected = {}
+    return load, blocks, repeat, given == ["spectrum"]
 
+
+def _scheme(jumping: dict, jumping_raw: dict) -> tuple[Optional[str], Optional[str]]:
+    """The stepping scheme and the preset, the preset's values filled into ``jumping`` where not given."""
     preset = jumping.get("preset")
     if preset is not None:
         for k, v in PRESETS[preset].items():
-            if jumping_raw.get(k) in (None, "auto") and k != "linear":
-                jumping[k if k != "max" else "max"] = v
+            if jumping_raw.get(k) in (None, "auto"):
+                jumping[k] = v
     scheme = jumping.get("scheme")
     if scheme is None:
         # a block giving only `linear` keeps its original meaning: explicit linear jumping
-        scheme = "linear" if jumping.get("linear") is not None and preset is None else "bdf2"
+        scheme = "linear" if jumping.get("linear") is not None and preset is None else DEFAULT_SCHEME
+    return scheme, preset
+
+
+def _check_model(r: "_Reader", geometry, materials: dict, model: dict, mu: Optional[float]) -> None:
+    """What the model's choices need of the rest of the case: a 3D point contact, the wear law's coefficients, a
+    friction coefficient where the cycle or the law resolves the traction, an odd number of increments."""
     dimension = model.get("dimension")
     if geometry is not None and dimension == "2d" and not geometry.has_2d:
         r.fail("model.dimension", f"a {geometry.kind} is a point contact: it needs 3d (2d is a line contact)")
-
-    law, slip, mu = model.get("wear_law"), model.get("slip"), load.get("friction_coefficient")
-    key = "wear_coefficient" if law == "archard" else "energy_wear_coefficient"
-    for body, m in materials.items():
-        if getattr(m, key) is None:
-            r.fail(f"materials.{body}.{key}", f"missing; model.wear_law {law} needs it, e.g. "
-                                              f"'{_example(key)}'")
-    stroke_model = model.get("stroke")
-    if mu is None and (slip == "coulomb" or law == "energy" or stroke_model == "resolved"):
-        why = ("model.slip coulomb" if slip == "coulomb" else
-               "model.wear_law energy (dh = α·|q|·|ds|, |q| = μp)" if law == "energy" else
-               "model.stroke resolved (the shear traction μp it reports at each increment)")
+    law = WEAR_LAWS.get(model.get("wear_law"))
+    if law is not None:
+        for body, m in materials.items():
+            if getattr(m, law.coefficient_key) is None:
+                r.fail(f"materials.{body}.{law.coefficient_key}", f"missing; model.wear_law {law.name} needs it, "
+                                                                   f"e.g. '{_example(law.coefficient_key)}'")
+    slip = model.get("slip")
+    why = friction_needed(slip, model.get("stroke"), law)
+    if mu is None and why:
         r.fail("loading.friction_coefficient", f"missing; {why} needs it, e.g. 0.9")
     if model.get("increments") is not None and model["increments"] % 2 == 0:
         r.fail("model.increments", f"{model['increments']} is even; expected an odd number, so that one increment "
                                    f"is centred on mid-stroke (e.g. {model['increments'] + 1})")
-    if mu == 0 and slip == "coulomb":
-        r.fail("loading.friction_coefficient", "0 with model.slip coulomb: without friction nothing resists "
-                                               "the stroke and nothing wears by it; give μ > 0")
-    domain, elements, coarse = grid.get("domain"), grid.get("elements"), grid.get("coarse_element")
-    stroke = load.get("stroke")
-    if domain is not None and stroke is not None and stroke >= domain[0] / 2:
-        r.fail("loading.stroke", f"the stroke amplitude {format_quantity(stroke, 'length')} is larger than half "
-                                 f"the grid's x extent ({domain[0]:.4g} mm): check its unit")
-    if problems or geometry is None:
-        if not problems:
-            r.fail("geometry", "incomplete")
-        return None
-    if blocks is not None:
-        from fretsim.loading import expand
-        applied = expand(blocks, repeat, load.get("cycles"), given == ["spectrum"])
-        if len(applied) > MAX_BLOCKS:
-            r.fail("loading.repeat", f"{len(applied)} blocks in all; at most {MAX_BLOCKS} (each restarts the "
-                                     f"stepping): fewer passes, or longer blocks")
-        load["normal_load"] = max(b.normal_load for b in blocks)
-        stroke = max(b.stroke for b in blocks)
-        load["cycles"] = sum(b.cycles for b in applied)
-    if dict(limits).get("wall_loss") is not None and geometry is not None and geometry.kind != "tube_on_flat":
-        r.fail("limits.wall_loss", f"a wall loss is a tube's (tube_on_flat); a {geometry.kind} has no wall: use "
-                                   f"max_wear_depth_moving")
-    if problems:
-        return None
-    return Case(name=name, geometry=geometry, moving=materials["moving"], stationary=materials["stationary"],
-                normal_load=load["normal_load"], stroke=stroke, cycles=load["cycles"],
-                blocks=blocks, repeat=repeat, spectrum=given == ["spectrum"], frequency=load.get("frequency"),
-                limits=limits,
-                friction_coefficient=load.get("friction_coefficient"),
-                tangential_stiffness=load.get("tangential_stiffness"), dimension=dimension,
-                gap_model=model["gap"], corrections=model["corrections"], accuracy=model["accuracy"],
-                pressure_accuracy=model.get("pressure_accuracy"),
-                slip=model["slip"], stroke_model=model["stroke"], wear_law=model["wear_law"],
-                increments=model["increments"],
-                solver=solver["method"],
-                tolerance=solver["tolerance"], scheme=scheme, step_tolerance=jumping["tolerance"],
-                linear_jump=jumping.get("linear") if scheme in ("linear", "adaptive") else jumping.get("linear"),
-                eta=jumping["eta"], max_jump=jumping.get("max"), preset=preset, coarse_element=coarse,
-                grid_rule=grid["rule"], grid_error=grid["error_estimate"],
-                domain=domain, elements=elements, snapshots=output.get("snapshots"), expected=expected,
-                overrides=overrides, source=source)
+    if mu == 0 and slip in CYCLES and CYCLES[slip].needs_friction:
+        r.fail("loading.friction_coefficient", f"0 with model.slip {slip}: without friction nothing resists "
+                                               f"the stroke and nothing wears by it; give μ > 0")
+
+
+def _loading(r: "_Reader", load: dict, blocks: Optional[tuple], repeat: int, spectrum: bool) -> Loading:
+    """The case's :class:`~fretsim.loading.Loading` (a problem recorded for a history of too many blocks)."""
+    mu, k_t, frequency = load.get("friction_coefficient"), load.get("tangential_stiffness"), load.get("frequency")
+    if blocks is None:
+        return Loading.constant(load["normal_load"], load["stroke"], load["cycles"], mu, k_t, frequency)
+    applied = expand(blocks, repeat, load.get("cycles"), spectrum)
+    if len(applied) > MAX_BLOCKS:
+        r.fail("loading.repeat", f"{len(applied)} blocks in all; at most {MAX_BLOCKS} (each restarts the "
+                                 f"stepping): fewer passes, or longer blocks")
+    return Loading(blocks, sum(b.cycles for b in applied), repeat, spectrum, True, mu, k_t, frequency)

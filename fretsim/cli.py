@@ -138,9 +138,9 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
                 click.echo(long, err=True)
         progress.start(setup)
 
-    import fretsim.plan as plan_module
-    if not quiet:  # the proxies, a pilot and the companions can take a minute: say what is running, and how far
-        _side_runs(plan_module, progress.stop)
+    from fretsim.plan import SideRuns
+    # the proxies, a pilot and the companions can take a minute: say what is running, and how far
+    runs = SideRuns() if quiet else _side_runs(progress.stop)[0]
     try:
         previous_handler = signal.signal(signal.SIGTERM, _terminate)
     except ValueError:  # not the main thread (the CLI called from a thread): SIGTERM keeps its handler
@@ -148,10 +148,11 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
     outcome = None
     try:
         if resume_file is not None:
-            outcome = resume_run(resume_file, progress=progress.update)
+            outcome = resume_run(resume_file, progress=progress.update, runs=runs)
         else:
             case = load_case(case_file, list(overrides))
-            outcome = run_case(case, output, overwrite=overwrite, progress=progress.update, on_plan=_on_plan)
+            outcome = run_case(case, output, overwrite=overwrite, progress=progress.update, on_plan=_on_plan,
+                               runs=runs)
     except KeyboardInterrupt:
         if _status_of(output) == "complete":  # the interrupt came after the last write
             click.echo(f"interrupted after the run had completed: {output} holds the whole run (status 'complete')")
@@ -161,7 +162,6 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
     except OSError as exc:  # before any step: the output's place cannot be written
         raise Fail(f"cannot write {output}: {exc.strerror or exc}") from None
     finally:
-        plan_module.announce = plan_module.side_progress = None
         progress.stop()
         try:
             signal.signal(signal.SIGTERM, previous_handler)
@@ -181,11 +181,14 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
     click.echo(_paragraph(outcome))
 
 
-def _side_runs(plan_module, before=lambda: None) -> list:
-    """Have the runs a run makes besides its own say what they are, when (seconds since now) and how far they are
-    (a bar on a terminal).  ``before`` ends what was shown before (the run's own bar)."""
+def _side_runs(before=lambda: None) -> tuple:
+    """The runs a run makes besides its own, saying what they are, when (seconds since now) and how far they are
+    (a bar on a terminal): a :class:`fretsim.plan.SideRuns`, and the list of what it said.  ``before`` ends what
+    was shown before (the run's own bar)."""
     import contextlib
     import time
+
+    from fretsim.plan import SideRuns
     started = time.perf_counter()
     said: list = []
 
@@ -206,8 +209,7 @@ def _side_runs(plan_module, before=lambda: None) -> list:
         finally:
             bar.stop()
 
-    plan_module.announce, plan_module.side_progress = announce, side_progress
-    return said
+    return SideRuns(announce, side_progress), said
 
 
 def _status_of(path) -> Optional[str]:
@@ -270,9 +272,10 @@ class _Progress:
 
 def _regime(s: dict, c) -> str:
     """The regime sentence of the summary: measured (coulomb) or assumed (uniform slip)."""
-    if c.slip == "uniform":
-        known = "" if c.friction_coefficient is None else (
-            f" (the stroke is {c.stroke / (s['gross_slip_stroke_um'] * 1e-3):.3g}× the gross-slip limit "
+    from fretsim.cycle import CYCLES
+    if CYCLES[c.slip].assumes_gross_slip:
+        known = "" if c.loading.friction_coefficient is None else (
+            f" (the stroke is {c.loading.peak_stroke / (s['gross_slip_stroke_um'] * 1e-3):.3g}× the gross-slip limit "
             f"{s['gross_slip_stroke_um']:.3g} µm)")
         return f"Gross slip assumed{known}."
     where = (f"stick zone ±{s['stick_half_width_x_mm'] * 1e3:.3g} µm along x" if s["regime"] == "partial_slip"
@@ -311,9 +314,9 @@ def _limits(s: dict, c) -> str:
         text = f" Wear limit reached: {key} = {shown(key, limits[key])} at cycle {n:,.0f}"
         if math.isfinite(err):
             text += f" (± {err:.1e} relative)"
-        if c.frequency:
+        if c.loading.frequency:
             hours = s["time_to_limit_h"]
-            text += (f", {hours:,.4g} h at {c.frequency:g} Hz" + (f" ({hours / 8766:.3g} years of continuous "
+            text += (f", {hours:,.4g} h at {c.loading.frequency:g} Hz" + (f" ({hours / 8766:.3g} years of continuous "
                                                                   f"fretting)" if hours > 24 * 30 else ""))
         return text + "."
     return f" No wear limit reached within {s['cycles']:,} cycles ({', '.join(f'{k} = {shown(k, v)}' for k, v in limits.items())})."
@@ -323,17 +326,11 @@ def _paragraph(outcome) -> str:
     s, c, g = outcome.summary, outcome.case, outcome.setup.grid
     cells = f"{g.shape[1]} elements" if g.plane_strain else f"{g.shape[1]} × {g.shape[0]} elements"
     size = f"{g.dx * 1e3:.3g} µm" if g.plane_strain else f"{g.dx * 1e3:.3g} × {g.dy * 1e3:.3g} µm"
-    stepping = {
-        "bdf2": f"BDF2 steps (tolerance {c.step_tolerance:g})",
-        "implicit": f"backward-Euler steps (tolerance {c.step_tolerance:g})",
-        "linear": f"linear jump {s['linear_jump']} cycles (stability limit {s['stability_limit_linear']:.3g})",
-        "adaptive": f"adaptive jumps (η {c.eta:g}, ΔN_max {c.max_jump}, ΔN_L {s['linear_jump']})",
-    }[c.scheme]
+    stepping = outcome.setup.stepper.describe(c, s)
     refined = f", contact on a {c.coarse_element[0] * 1e3:.3g} µm coarse grid" if c.coarse_element else ""
-    model = (f"gap model {c.gap_model}" if c.slip == "uniform" and c.stroke_model == "mid_stroke" else
-             f"{c.slip} slip, stroke {c.stroke_model.replace('_', '-')}, {c.increments} increments per half-stroke")
+    model = outcome.setup.cycle.describe()
     reached = (outcome.last.block + 1) if outcome.last is not None else 0
-    blocks = "" if c.blocks is None else f" ({reached} of the loading's {len(c.history())} blocks)"
+    blocks = "" if not c.loading.history else f" ({reached} of the loading's {len(c.loading.blocks)} blocks)"
     text = (f"{c.name}: {s['cycles']} cycles{blocks}, {c.dimension.upper()} {c.geometry.kind}, {cells} of {size}{refined}, "
             f"{model}, solver {c.solver}, {stepping}; {s['contact_solves']} contact solves in "
             f"{s['wall_time_s']:.2f} s" + (f" (and {s['grid_error_wall_time_s']:.2f} s for the grid-error companions)"
@@ -362,36 +359,33 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
     stability limit, an estimate of the solves and time, and every warning."""
     import time
 
-    import fretsim.plan as plan_module
     from fretsim.api import check as check_case, load_case
 
     started = time.perf_counter()
-    said = _side_runs(plan_module)
-    try:
-        setup, filled, plan = check_case(load_case(case_file, list(overrides)))
-    finally:
-        plan_module.announce = plan_module.side_progress = None
+    runs, said = _side_runs()
+    setup, filled, plan = check_case(load_case(case_file, list(overrides)), runs)
     planning = time.perf_counter() - started
     g = setup.grid
     cells = f"{g.shape[1]} elements of {g.dx * 1e3:.4g} µm" if g.plane_strain else \
         f"{g.shape[1]} × {g.shape[0]} elements of {g.dx * 1e3:.4g} × {g.dy * 1e3:.4g} µm"
-    click.echo(f"{filled.name}: {filled.cycles} cycles, {filled.dimension.upper()} {filled.geometry.kind}, {cells}")
+    loading = filled.loading
+    click.echo(f"{filled.name}: {loading.cycles} cycles, {filled.dimension.upper()} {filled.geometry.kind}, {cells}")
     from fretsim.reference import effective_modulus
     e_star = effective_modulus(filled.moving.youngs_modulus, filled.moving.poissons_ratio,
                                filled.stationary.youngs_modulus, filled.stationary.poissons_ratio)
-    h = filled.geometry.hertz(filled.normal_load, e_star)
+    h = filled.geometry.hertz(loading.peak_load, e_star)
     click.echo(f"unworn contact (Hertz): peak pressure p0 = {h.peak_pressure:.4g} MPa, half-width a = "
                f"{h.half_width_x * 1e3:.4g} µm" + ("" if h.line else f" × {h.half_width_y * 1e3:.4g} µm")
                + f", E* = {e_star / 1e3:.4g} GPa")
     click.echo(f"explicit stability limit: {setup.stability_limit:.4g} cycles (solve grid, gap model {filled.gap_model})")
-    if filled.friction_coefficient is not None:
-        d_t = setup.gross_slip_stroke
-        regime = "gross slip" if filled.stroke > d_t else "partial slip"
-        click.echo(f"regime: {regime} at the start — the stroke {filled.stroke * 1e3:.4g} µm is "
-                   f"{filled.stroke / d_t:.3g}× the gross-slip limit δ_t = {d_t * 1e3:.4g} µm (μ = "
-                   f"{filled.friction_coefficient:g}, the unworn contact)")
+    if loading.friction_coefficient is not None:
+        d_t, stroke = setup.gross_slip_stroke, loading.peak_stroke
+        regime = "gross slip" if stroke > d_t else "partial slip"
+        click.echo(f"regime: {regime} at the start — the stroke {stroke * 1e3:.4g} µm is "
+                   f"{stroke / d_t:.3g}× the gross-slip limit δ_t = {d_t * 1e3:.4g} µm (μ = "
+                   f"{loading.friction_coefficient:g}, the unworn contact)")
     from fretsim.runner import estimate
-    cost = estimate(setup, filled)
+    cost = estimate(setup, filled, runs)
     total = cost["run_s"] + cost["companions_s"] + (planning if planning > 1.0 else 0.0)
     click.echo(f"estimate: about {cost['solves']} contact solves, {_duration(cost['run_s'])} for the run "
                f"(jumping.tolerance {filled.step_tolerance:g})"

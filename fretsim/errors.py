@@ -4,6 +4,9 @@
   :class:`fretsim.case.CaseError` is one.
 * :class:`ResultsFileError` — a results file or sweep table that is missing, damaged or not ours: exit 2.
   A ValueError, so callers that catch ValueError keep working.
+* :class:`SimulationError` — a run that had to stop (raised by the loop, :mod:`fretsim.simulate`): a numerical
+  failure or a contact that outgrew its grid (exit 3), a grid that cannot resolve the contact (2), a body worn
+  through (4).
 """
 from __future__ import annotations
 
@@ -14,3 +17,33 @@ class InputError(Exception):
 
 class ResultsFileError(ValueError):
     """A results file (or a sweep's table) that cannot be read or verified; the message names what is wrong."""
+
+
+class SimulationError(Exception):
+    """A run that had to stop: ``cycle`` is the last cycle reached (exit 3 unless a subclass says otherwise)."""
+
+    exit_code = 3
+
+    def __init__(self, message: str, cycle: int):
+        super().__init__(message)
+        self.cycle = cycle
+
+
+class NumericalFailure(SimulationError):
+    """No convergence, NaN, instability or a broken invariant."""
+
+
+class DomainError(SimulationError):
+    """The contact outgrew the grid."""
+
+
+class ResolutionError(SimulationError):
+    """The grid cannot resolve the contact (too few elements across it): an input problem, found at the start."""
+
+    exit_code = 2
+
+
+class PhysicalLimit(SimulationError):
+    """The wear went through the body: the geometry means nothing beyond this cycle."""
+
+    exit_code = 4

@@ -42,13 +42,18 @@ def _odd(n: float) -> int:
     return n if n % 2 else n + 1
 
 
+def companions_wanted(filled) -> bool:
+    """Whether a finished case's grid error is estimated by companions: asked for, a run that wears, a grid."""
+    return filled.grid_error != "none" and filled.loading.cycles > 0 and filled.elements is not None
+
+
 def companion_case(filled, line_contact: bool, times: int = 1):
     """The finished case (automatic choices filled) on a grid COARSER**times coarser, otherwise unchanged."""
     e, f = filled.elements, COARSER ** times
     elements = (_odd(e[0] / f),) + (() if len(e) == 1 else (e[1],) if line_contact else (_odd(e[1] / f),))
     coarse = None if filled.coarse_element is None else tuple(c * f for c in filled.coarse_element)
     return filled.with_choices(elements=elements, coarse_element=coarse, grid_error="none",
-                               snapshots=(filled.cycles,))
+                               snapshots=(filled.loading.cycles,))
 
 
 def _relative(a: float, b: float) -> float:

@@ -9,6 +9,7 @@ its own cycle model; the loop restarts its stepping at each block's start as it 
 from __future__ import annotations
 
 from dataclasses import dataclass, replace
+from functools import cached_property
 from typing import Optional
 
 
@@ -60,17 +61,60 @@ def expand(blocks: tuple, repeat: int = 1, cycles: Optional[int] = None, spectru
 
 @dataclass(frozen=True)
 class Loading:
-    """The blocks of a run, applied one after another."""
+    """What the rig applies, one object for a constant loading and a load history alike (``Case.loading``).
 
-    blocks: tuple[Block, ...]
+    ``given`` is the loading as the case writes it: one block (``normal_load``, ``stroke``, ``cycles``), or one pass
+    of ``loading.blocks`` (applied ``repeat`` times, or repeated up to ``cycles``), or a spectrum's blocks
+    (fractions of ``cycles`` split over ``repeat`` passes).  ``blocks`` are the blocks in the order applied, which
+    the loop steps through; a block's μ defaults to the loading's.  Internal units: N, mm, N/mm, Hz.
+    """
+
+    given: tuple[Block, ...]
+    cycles: int  # the total applied
+    repeat: int = 1
+    spectrum: bool = False  # ``given`` came from loading.spectrum (fractions of the cycles, split in passes)
+    history: bool = False  # given as loading.blocks or loading.spectrum (not one load)
+    friction_coefficient: Optional[float] = None  # the loading's μ; a block may give its own
+    tangential_stiffness: Optional[float] = None  # N/mm, the rig's; None: a rigid rig
+    frequency: Optional[float] = None  # Hz: with it, the time to a wear limit
 
     def __post_init__(self):
-        if not self.blocks:
+        if not self.given:
             raise ValueError("a loading needs at least one block")
 
+    @classmethod
+    def constant(cls, normal_load: float, stroke: float, cycles: int, friction_coefficient: Optional[float] = None,
+                 tangential_stiffness: Optional[float] = None, frequency: Optional[float] = None) -> "Loading":
+        """One load and stroke held for ``cycles``."""
+        return cls((Block(normal_load, stroke, cycles, friction_coefficient, tangential_stiffness),), cycles,
+                   friction_coefficient=friction_coefficient, tangential_stiffness=tangential_stiffness,
+                   frequency=frequency)
+
+    @cached_property
+    def blocks(self) -> tuple[Block, ...]:
+        """The blocks in the order applied (repeats and spectrum passes expanded); one for a constant loading."""
+        if not self.history:
+            return (replace(self.given[0], cycles=self.cycles),)
+        return expand(self.given, self.repeat, self.cycles, self.spectrum)
+
+    def with_cycles(self, cycles: int) -> "Loading":
+        """The same loading over ``cycles`` (a history is repeated, or cut short, to that many)."""
+        return replace(self, cycles=cycles)
+
     @property
-    def cycles(self) -> int:
-        return sum(b.cycles for b in self.blocks)
+    def peak_load(self) -> float:
+        """The largest normal load of any block (N): what sizes the contact's reach and its plausibility."""
+        return max(b.normal_load for b in self.given)
+
+    @property
+    def peak_stroke(self) -> float:
+        """The largest stroke of any block (mm)."""
+        return max(b.stroke for b in self.given)
+
+    @property
+    def lightest_load(self) -> float:
+        """The smallest normal load applied (N): the narrowest contact the grid must resolve."""
+        return min(b.normal_load for b in self.blocks)
 
     def block_at(self, cycle: int) -> Block:
         """The block that cycle ``cycle`` + 1 belongs to (the last block from its start on)."""
@@ -94,3 +138,13 @@ class Loading:
             ends.append(n)
         return tuple(ends)
 
+    def worn_work(self, cycles: int) -> float:
+        """Σ Pᵢ·4δᵢ·Nᵢ over the first ``cycles`` cycles of the blocks (N·mm): times k, the worn volume."""
+        work, left = 0.0, cycles
+        for b in self.blocks:
+            n = min(b.cycles, left)
+            work += b.normal_load * 4 * b.stroke * n
+            left -= n
+            if left <= 0:
+                break
+        return work

@@ -117,6 +117,14 @@ SUMMARY_WEAR = ("max_wear_depth_moving", "max_wear_depth_stationary", "centre_we
                 "wear_volume_stationary")  # the wear quantities of the summary, in its order
 
 
+# how messages name a figure (auto's proxies compare the models on these)
+SAID = {"max_wear_depth_moving_um": "the moving body's maximum depth",
+        "max_wear_depth_stationary_um": "the flat's maximum depth",
+        "centre_wear_depth_stationary_um": "the flat's centre-line depth",
+        "scar_width_moving_mm": "the moving body's scar width", "scar_width_stationary_mm": "the flat's scar width",
+        "max_pressure_MPa": "the peak pressure"}
+
+
 def unit_of(summary_key: str) -> str:
     """The unit of a summary figure ("1" for one fretsim does not report)."""
     figure = SUMMARY.get(summary_key)

@@ -16,7 +16,7 @@ import numpy as np
 
 from fretsim import grid_error
 from fretsim.case import GEOMETRY_KEYS, Case, CaseError, parse_case
-from fretsim.plan import Plan, prepare
+from fretsim.plan import Plan, SideRuns, estimate_cost, prepare
 from fretsim.reference import effective_modulus
 from fretsim.results import (OutputBusy, OutputClaim, Results, ResultsIOError, ResultsWriter, check_output_path,
                              read_results)
@@ -56,14 +56,14 @@ class _Counter:
             self.errors = (max(self.errors[0], step.error_depth), max(self.errors[1], step.error_pressure))
 
 
-def check(case: Case) -> tuple[Setup, Case, Plan]:
+def check(case: Case, runs: Optional[SideRuns] = None) -> tuple[Setup, Case, Plan]:
     """Everything a run would decide, without running: the setup, the filled case and the plan of choices."""
-    return prepare(case)
+    return prepare(case, runs=runs)
 
 
 def inputs_of(case: Case) -> dict:
     """The resolved inputs of a filled case: name → (value, units, long name), as recorded in /inputs."""
-    g = case.geometry
+    g, loading = case.geometry, case.loading
     values: dict = {"geometry": (g.kind, "", "contact geometry")}
     for key, spec in GEOMETRY_KEYS[g.kind].items():
         value = getattr(g, key, None)
@@ -80,9 +80,9 @@ def inputs_of(case: Case) -> dict:
             values[f"{body}_energy_wear_coefficient"] = (m.energy_wear_coefficient * 1e3, "mm^3/J",
                                                           f"energy wear coefficient, {body} body")
     values.update({
-        "normal_load": (case.normal_load, "N", "normal load"),
-        "stroke": (case.stroke * 1e3, "um", "slip amplitude"),
-        "cycles": (case.cycles, "cycles", "fretting cycles"),
+        "normal_load": (loading.peak_load, "N", "normal load"),
+        "stroke": (loading.peak_stroke * 1e3, "um", "slip amplitude"),
+        "cycles": (loading.cycles, "cycles", "fretting cycles"),
         "dimension": (case.dimension, "", "model dimension"),
         "gap_model": (case.gap_model, "", "how the flat's wear enters the gap"),
         "solver": (case.solver, "", "contact solver"),
@@ -95,13 +95,13 @@ def inputs_of(case: Case) -> dict:
         "wear_law": (case.wear_law, "", "archard (k·p·|ds|) or energy (α·|q|·|ds|)"),
         "increments": (case.increments, "1", "increments per half-stroke (coulomb)"),
     })
-    if case.friction_coefficient is not None:
-        values["friction_coefficient"] = (case.friction_coefficient, "1", "friction coefficient")
-    if case.tangential_stiffness is not None:
-        values["tangential_stiffness"] = (case.tangential_stiffness * 1e-3, "N/um", "the rig's tangential stiffness")
+    if loading.friction_coefficient is not None:
+        values["friction_coefficient"] = (loading.friction_coefficient, "1", "friction coefficient")
+    if loading.tangential_stiffness is not None:
+        values["tangential_stiffness"] = (loading.tangential_stiffness * 1e-3, "N/um", "the rig's tangential stiffness")
     e_star = effective_modulus(case.moving.youngs_modulus, case.moving.poissons_ratio,
                                case.stationary.youngs_modulus, case.stationary.poissons_ratio)
-    h = g.hertz(case.normal_load, e_star)
+    h = g.hertz(loading.peak_load, e_star)
     values.update({"contact_modulus": (e_star / 1e3, "GPa", "contact modulus E*"),
                    "hertz_half_width_x": (h.half_width_x, "mm", "Hertz contact half-width along x"),
                    "hertz_half_width_y": (h.half_width_y, "mm", "Hertz contact half-width along y"),
@@ -112,15 +112,18 @@ def inputs_of(case: Case) -> dict:
 
 def run(case: Case, output: Optional[str | Path] = None, *, overwrite: bool = False,
         progress: Optional[Callable[[int], None]] = None, observers: tuple = (),
-        on_plan: Optional[Callable[[Setup, Case, Plan], None]] = None) -> Outcome:
+        on_plan: Optional[Callable[[Setup, Case, Plan], None]] = None, runs: Optional[SideRuns] = None) -> Outcome:
     """Run a case; write the results file if ``output`` is given.
 
     Raises :class:`CaseError` for a case or an output that cannot be used (nothing is written then).  A run
     that fails, stops at a physical limit or cannot write returns an outcome with that status; KeyboardInterrupt
     is re-raised after the file is written with status ``interrupted``.  ``on_plan`` is called with the plan
-    before the first solve (the CLI prints the choices then).
+    before the first solve (the CLI prints the choices then).  ``runs`` (:class:`fretsim.plan.SideRuns`)
+    announces the runs made besides this one (auto's proxies, a pilot, the grid-error companions) and keeps
+    the proxies for the next plan in its keeping.
     """
-    setup, filled, plan = prepare(case)
+    runs = runs if runs is not None else SideRuns()
+    setup, filled, plan = prepare(case, runs=runs)
     claim = None
     if output is not None:
         try:
@@ -138,8 +141,8 @@ def run(case: Case, output: Optional[str | Path] = None, *, overwrite: bool = Fa
     try:
         if on_plan is not None:
             on_plan(setup, filled, plan)
-        return _execute(setup, filled, plan, output, overwrite, progress, observers, resume_from=None,
-                        input_sha256=case.fingerprint())
+        sink = _Sink(output, setup, filled, plan, overwrite, None, case.fingerprint())
+        return _execute(setup, filled, plan, sink, progress, observers, None, runs)
     finally:
         if claim is not None:
             claim.release()
@@ -155,12 +158,13 @@ def _claim(path: Path) -> OutputClaim:
 
 
 def resume(output: str | Path, *, progress: Optional[Callable[[int], None]] = None,
-           observers: tuple = ()) -> Outcome:
+           observers: tuple = (), runs: Optional[SideRuns] = None) -> Outcome:
     """Continue an interrupted (or killed) run from the last state in its results file.
 
     The case is the one stored in the file, so the run continues exactly as it would have: the same steps,
     the same arrays.  The file is verified first (structure, shapes, checksums): a damaged one is refused.
     """
+    runs = runs if runs is not None else SideRuns()
     path = Path(output)
     claim = _claim(path) if path.exists() else None
     try:
@@ -172,98 +176,93 @@ def resume(output: str | Path, *, progress: Optional[Callable[[int], None]] = No
             raise CaseError(str(output), [("", f"the run's status is {previous.status!r}; only an interrupted or "
                                                f"killed run ({' or '.join(RESUMABLE)}) can be resumed")])
         case = parse_case(previous.case_yaml, source=f"{output}:/case")
-        setup, filled, plan = prepare(case)
+        setup, filled, plan = prepare(case, runs=runs)
         n = previous.checkpoint.get("n")
         if not isinstance(n, int) or not 0 <= n <= setup.cycles:
             raise CaseError(str(output), [("", f"/checkpoint: the cycle {str(n)[:20]} does not fit the case's "
                                                f"{setup.cycles} cycles")], "results file")
-        return _execute(setup, filled, plan, output, True, progress, observers, resume_from=previous)
+        sink = _Sink(output, setup, filled, plan, True, previous)
+        return _execute(setup, filled, plan, sink, progress, observers, previous, runs)
     finally:
         if claim is not None:
             claim.release()
 
 
-def _execute(setup, filled, plan, output, overwrite, progress, observers, resume_from: Optional[Results],
-             input_sha256: str = "") -> Outcome:
+class _Sink:
+    """The results file of a run, created at its first accepted step (a case that fails its first solve writes
+    nothing), and finished whatever ends the run."""
+
+    def __init__(self, output, setup, filled, plan, overwrite: bool, previous: Optional[Results],
+                 input_sha256: str = ""):
+        self.output, self.setup, self.filled, self.plan = output, setup, filled, plan
+        self.overwrite, self.previous, self.input_sha256 = overwrite, previous, input_sha256
+        self.writer: Optional[ResultsWriter] = None
+
+    def open(self, overwrite: bool) -> None:
+        if self.writer is None and self.output is not None:
+            self.writer = ResultsWriter(self.output, self.filled.to_yaml(), self.filled.name, self.setup.grid,
+                                        self.setup.notes, overwrite, previous=self.previous,
+                                        choices=self.plan.choices, inputs=inputs_of(self.filled),
+                                        input_sha256=self.input_sha256)
+
+    def on_step(self, setup_, step) -> None:
+        self.open(self.overwrite)
+        if self.writer is not None:
+            self.writer.on_step(setup_, step)
+
+    def cycle_on_disk(self) -> Optional[int]:
+        writer = self.writer
+        if writer is None or not writer.path.exists() or not writer._placed:
+            return None
+        try:
+            return int(read_results(writer.path).history["cycle"][-1])
+        except (ValueError, IndexError):
+            return None
+
+    def finish(self, counter, t0, status: str, message: str) -> None:
+        if self.writer is not None:
+            self.writer.notes = tuple(dict.fromkeys(self.writer.notes + tuple(counter.notes)))
+            self.writer.finish(status, message, _summary(self.setup, counter, t0))
+
+    def finish_interrupted(self, counter, t0, message: str) -> None:
+        """Record an interruption: a second Ctrl-C must not interrupt the write that records the first, and a disk
+        that refuses leaves the last good flush (status 'running'), still resumable."""
+        previous = _ignore_signals()
+        try:
+            self.finish(counter, t0, "interrupted", message)
+        except ResultsIOError:
+            pass
+        finally:
+            _restore_signals(previous)
+
+
+def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from: Optional[Results],
+             runs: SideRuns) -> Outcome:
     counter = _Counter(len(resume_from.history["cycle"]) if resume_from is not None else 0,
                        _recorded_errors(resume_from) if resume_from is not None else (0.0, 0.0))
-    writer = None
     t0 = time.perf_counter()
-
-    class _LazyWriter:
-        """Creates the file at the first accepted step, so a case that fails its first solve writes nothing."""
-
-        def on_step(self, setup_, step):
-            nonlocal writer
-            if writer is None and output is not None:
-                writer = ResultsWriter(output, filled.to_yaml(), filled.name, setup.grid, setup.notes, overwrite,
-                                       previous=resume_from, choices=plan.choices, inputs=inputs_of(filled),
-                                       input_sha256=input_sha256)
-            if writer is not None:
-                writer.on_step(setup_, step)
-
-    status, message = "complete", ""
     state = resume_from.checkpoint if resume_from is not None else None
+    output = sink.output
     try:
-        last = simulate(setup, (counter, _LazyWriter()) + tuple(observers), progress, resume=state)
-        if counter.last is None and last is not None:  # resumed at its end: nothing left to do
-            counter.last = last
-            if output is not None and writer is None:
-                writer = ResultsWriter(output, filled.to_yaml(), filled.name, setup.grid, setup.notes, True,
-                                       previous=resume_from, choices=plan.choices, inputs=inputs_of(filled),
-                                       input_sha256=input_sha256)
-                writer.state = resume_from.checkpoint
-    except ResolutionError as exc:  # found before anything is written: an input problem, named as such
-        given = any(c.key == "grid.elements" and c.given for c in plan.choices)
-        key = "grid.elements" if given else "grid"
-        advice = ("refine grid.elements or shrink grid.domain" if given else
-                  "the automatic grid should resolve it: set grid.domain and grid.elements explicitly")
-        raise CaseError(filled.source, [(key, f"{exc}; {advice}")]) from None
+        status, message = _simulate(setup, filled, plan, counter, sink, observers, progress, state)
     except ResultsIOError as exc:
-        cycle = _cycle_on_disk(writer)
+        cycle = sink.cycle_on_disk()
         where = (f"the file holds every step up to cycle {cycle} (status 'running'); when there is room, continue "
                  f"with `fretsim run --resume {output}`" if cycle is not None else "nothing was written")
         return Outcome("io_error", f"{exc.strerror}; {where}", _summary(setup, counter, t0), setup, filled,
                        Path(output), counter.last, setup.notes, plan, cycle is not None)
-    except PhysicalLimit as exc:
-        status, message = "stopped", str(exc)
-    except SimulationError as exc:
-        status, message = "failed", str(exc)
     except KeyboardInterrupt:
-        previous = _ignore_signals()  # a second Ctrl-C must not interrupt the write that records the first
-        try:
-            cycle = counter.last.cycle if counter.last else (int(state["n"]) if state else 0)
-            _finish(writer, setup, counter, t0, "interrupted", f"interrupted after cycle {cycle}; resume with "
-                                                               f"`fretsim run --resume {output}`")
-        except ResultsIOError:
-            pass  # the last good flush stays (status 'running'): still resumable
-        finally:
-            _restore_signals(previous)
+        cycle = counter.last.cycle if counter.last else (int(state["n"]) if state else 0)
+        sink.finish_interrupted(counter, t0, f"interrupted after cycle {cycle}; resume with `fretsim run --resume "
+                                             f"{output}`")
         raise
     if status == "complete" and counter.last is not None:
-        started = time.perf_counter()
-        try:
-            counter.extra = _error_estimates(setup, filled, plan, counter)
-        except KeyboardInterrupt:
-            previous = _ignore_signals()
-            try:
-                _finish(writer, setup, counter, t0, "interrupted", "interrupted while estimating the grid's error "
-                        f"(the run itself is complete); resume with `fretsim run --resume {output}`")
-            except ResultsIOError:
-                pass
-            finally:
-                _restore_signals(previous)
-            raise
-        except Exception as exc:  # noqa: BLE001 - the run is complete: whatever stops its error estimate must not
-            #                                      cost it its file; the estimates are then unknown, and it says why
-            counter.notes.append(f"the grid's error was not estimated: {type(exc).__name__}: {str(exc)[:160]}")
-            counter.extra = {k: float("nan") for k in grid_error.KEYS + (grid_error.LIMIT_KEY,)}
-        counter.extra["grid_error_wall_time_s"] = time.perf_counter() - started
+        _estimate_errors(setup, filled, plan, counter, sink, t0, runs)
     previous = _ignore_signals()  # a Ctrl-C in the last instant must not make a complete run look interrupted
     try:
-        _finish(writer, setup, counter, t0, status, message)
+        sink.finish(counter, t0, status, message)
     except ResultsIOError as exc:
-        cycle = _cycle_on_disk(writer)
+        cycle = sink.cycle_on_disk()
         return Outcome("io_error", f"{exc.strerror}; the file holds every step up to cycle {cycle} (status "
                                    f"'running'); when there is room, continue with `fretsim run --resume {output}`",
                        _summary(setup, counter, t0), setup, filled, Path(output), counter.last, setup.notes, plan,
@@ -271,7 +270,46 @@ def _execute(setup, filled, plan, output, overwrite, progress, observers, resume
     finally:
         _restore_signals(previous)
     return Outcome(status, message, _summary(setup, counter, t0), setup, filled, Path(output) if output else None,
-                   counter.last, tuple(setup.notes) + tuple(counter.notes), plan, writer is not None)
+                   counter.last, tuple(setup.notes) + tuple(counter.notes), plan, sink.writer is not None)
+
+
+def _simulate(setup, filled, plan, counter, sink: _Sink, observers, progress, state) -> tuple[str, str]:
+    """The loop, its ending as a status and a message (a grid that cannot resolve the contact is bad input)."""
+    try:
+        last = simulate(setup, (counter, sink) + tuple(observers), progress, resume=state)
+    except ResolutionError as exc:  # found before anything is written: an input problem, named as such
+        given = any(c.key == "grid.elements" and c.given for c in plan.choices)
+        key = "grid.elements" if given else "grid"
+        advice = ("refine grid.elements or shrink grid.domain" if given else
+                  "the automatic grid should resolve it: set grid.domain and grid.elements explicitly")
+        raise CaseError(filled.source, [(key, f"{exc}; {advice}")]) from None
+    except PhysicalLimit as exc:
+        return "stopped", str(exc)
+    except SimulationError as exc:
+        return "failed", str(exc)
+    if counter.last is None and last is not None:  # resumed at its end: nothing left to do
+        counter.last = last
+        if sink.output is not None and sink.writer is None:
+            sink.open(True)
+            sink.writer.state = state
+    return "complete", ""
+
+
+def _estimate_errors(setup, filled, plan, counter, sink: _Sink, t0, runs: SideRuns) -> None:
+    """The complete run's error estimates into ``counter.extra``; whatever stops them must not cost the run its
+    file: the estimates are then unknown, and it says why."""
+    started = time.perf_counter()
+    try:
+        counter.extra = _error_estimates(setup, filled, plan, counter, runs)
+    except KeyboardInterrupt:
+        sink.finish_interrupted(counter, t0, "interrupted while estimating the grid's error (the run itself is "
+                                             f"complete); resume with `fretsim run --resume {sink.output}`")
+        raise
+    except Exception as exc:  # noqa: BLE001 - the run is complete: whatever stops its error estimate must not
+        #                                      cost it its file; the estimates are then unknown, and it says why
+        counter.notes.append(f"the grid's error was not estimated: {type(exc).__name__}: {str(exc)[:160]}")
+        counter.extra = {k: float("nan") for k in grid_error.KEYS + (grid_error.LIMIT_KEY,)}
+    counter.extra["grid_error_wall_time_s"] = time.perf_counter() - started
 
 
 def _ignore_signals() -> dict:
@@ -284,15 +322,6 @@ def _ignore_signals() -> dict:
 def _restore_signals(previous: dict) -> None:
     for sig, handler in previous.items():
         signal.signal(sig, handler)
-
-
-def _cycle_on_disk(writer) -> Optional[int]:
-    if writer is None or not writer.path.exists() or not writer._placed:
-        return None
-    try:
-        return int(read_results(writer.path).history["cycle"][-1])
-    except (ValueError, IndexError):
-        return None
 
 
 def _recorded_errors(previous: Results) -> tuple:
@@ -314,18 +343,17 @@ def _summary(setup, counter, t0) -> dict:
     return out
 
 
-def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter") -> dict:
+def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter", runs: SideRuns) -> dict:
     """The total error estimates of the reported numbers: the stepping's, the grid's (from a companion run on a
     grid twice as coarse, see :mod:`fretsim.grid_error`) and the model difference ``auto`` accepted."""
-    from fretsim.plan import prepare as prepare_case, side_run
     summary = summarize(setup, counter.last, counter.solves, 0.0, counter.errors)
     model_part = sum(c.error for c in plan.choices)
-    if filled.grid_error == "none" or filled.cycles == 0 or filled.elements is None:
+    if not _estimated(filled):
         return {**grid_error.totals(summary, None, model_part), grid_error.LIMIT_KEY: float("nan")}
     companion, coarsest_case = _companions(setup, filled)
     try:
-        c_setup, _, _ = prepare_case(companion)
-        last = side_run(f"grid error: the case again on a grid twice as coarse ({c_setup.grid.shape[1]} × "
+        c_setup, _, _ = prepare(companion, runs=runs)
+        last = runs.run(f"grid error: the case again on a grid twice as coarse ({c_setup.grid.shape[1]} × "
                         f"{c_setup.grid.shape[0]} elements) to estimate the grid's part of the error", c_setup)
     except (SimulationError, CaseError) as exc:  # e.g. the mid-stroke gap, stable on the run's grid, is not on
         #                                           the coarser one: the run stands, its grid error is unknown
@@ -333,7 +361,7 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
                              f"stopped ({str(exc)[:160]})")
         return {**grid_error.totals(summary, None, model_part), grid_error.LIMIT_KEY: float("nan")}
     coarse = summarize(c_setup, last, 0, 0.0)
-    coarsest = _coarsest(coarsest_case)
+    coarsest = _coarsest(coarsest_case, runs)
     part = grid_error.grid_estimates(summary, coarse, counter.last.pressure, setup.grid, last.pressure,
                                      c_setup.grid, coarsest)
     out = grid_error.totals(summary, part, model_part)
@@ -357,23 +385,27 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
     return out
 
 
-def estimate(setup: Setup, filled: Case) -> dict:
+def estimate(setup: Setup, filled: Case, runs: Optional[SideRuns] = None) -> dict:
     """What a run of this plan will cost besides its planning (auto's proxies, a limit's pilot: timed where they
     run): ``solves`` and ``run_s`` of its own loop, and ``companions_s`` of its grid-error companion runs, each
     from one timed solve on its grid (:func:`fretsim.plan.estimate_cost`)."""
-    from fretsim.plan import estimate_cost, prepare as prepare_case
     solves, seconds = estimate_cost(setup)
     out = {"solves": solves, "run_s": seconds, "companions_s": 0.0, "companions": 0}
-    if filled.grid_error == "none" or filled.cycles == 0 or filled.elements is None:
+    if not _estimated(filled):
         return out
     for case in _companions(setup, filled):
         try:
-            c_setup, _, _ = prepare_case(case)
+            c_setup, _, _ = prepare(case, runs=runs)
         except (SimulationError, CaseError):
             continue
         out["companions_s"] += estimate_cost(c_setup)[1]
         out["companions"] += 1
     return out
+
+
+def _estimated(filled: Case) -> bool:
+    """Whether the grid's part of a run's error is estimated (by companion runs on coarser grids)."""
+    return grid_error.companions_wanted(filled)
 
 
 def _companions(setup: Setup, filled: Case) -> tuple[Case, Case]:
@@ -383,14 +415,13 @@ def _companions(setup: Setup, filled: Case) -> tuple[Case, Case]:
     return tuple(grid_error.companion_case(filled, line_contact, times=times) for times in (1, 2))
 
 
-def _coarsest(case: Case) -> Optional[dict]:
+def _coarsest(case: Case, runs: SideRuns) -> Optional[dict]:
     """The summary of the run on a grid four times as coarse (whether the peak pressure converges), or None where
     that grid cannot carry the run (too few elements for the contact, an unstable gap): the peak is then read
     from two grids."""
-    from fretsim.plan import prepare as prepare_case, side_run
     try:
-        c_setup, _, _ = prepare_case(case)
-        return summarize(c_setup, side_run(f"grid error: the case again on a grid four times as coarse "
+        c_setup, _, _ = prepare(case, runs=runs)
+        return summarize(c_setup, runs.run(f"grid error: the case again on a grid four times as coarse "
                                            f"({c_setup.grid.shape[1]} × {c_setup.grid.shape[0]} elements) to see "
                                            f"whether the peak pressure converges", c_setup), 0, 0.0)
     except (SimulationError, CaseError):
@@ -399,9 +430,3 @@ def _coarsest(case: Case) -> Optional[dict]:
 
 def _elapsed(counter, t0) -> float:
     return float(counter.last.state.get("elapsed", time.perf_counter() - t0)) if counter.last else 0.0
-
-
-def _finish(writer, setup, counter, t0, status, message):
-    if writer is not None:
-        writer.notes = tuple(dict.fromkeys(writer.notes + tuple(counter.notes)))
-        writer.finish(status, message, _summary(setup, counter, t0))

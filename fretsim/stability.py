@@ -24,7 +24,6 @@ from typing import Optional
 import numpy as np
 
 from fretsim.compliance import HalfSpace
-from fretsim.wear import stroke_symbol, wear_operator
 
 SAFETY = 0.5  # default jump as a fraction of the limit: monotone decay of every mode
 WINDOW = (9, 48)  # rows, columns of the window for the general method
@@ -60,9 +59,9 @@ def _halfspace_symbol(plane_strain: bool, dx: float, dy: float, ny: int, e_star:
 THETA = tuple(np.linspace(0.01 * np.pi, np.pi, 160))
 
 
-def wear_spectrum(compliance, stroke: float, k_moving: float, k_stationary: float, gap_model: str,
-                  general: bool = False) -> Spectrum:
-    """μ_min and μ_max of the explicit update for ``compliance`` (closed form for a plain half-space)."""
+def wear_spectrum(compliance, stiffness, general: bool = False) -> Spectrum:
+    """μ_min and μ_max of the explicit update for ``compliance`` and the cycle's stiffness W (a
+    :class:`fretsim.wear.WearOperator` on the same grid): closed form for a plain half-space."""
     grid = compliance.grid
     if isinstance(compliance, HalfSpace) and not general:
         theta = np.array(THETA)
@@ -70,23 +69,26 @@ def wear_spectrum(compliance, stroke: float, k_moving: float, k_stationary: floa
         # difference): one symbol per aspect ratio serves every dx and E* (a sweep's points, the companions)
         aspect = 1.0 if grid.plane_strain else grid.dy / grid.dx
         f = _halfspace_symbol(grid.plane_strain, 1.0, aspect, grid.shape[0], 1.0, THETA) * (grid.dx / compliance.e_star)
-        b = stroke_symbol(grid.dx, stroke, theta)
-        seen = {"mid_stroke": b, "stroke_average": b * b, "resolved": np.ones_like(b)}[gap_model]
-        rate = 4.0 * stroke * (k_moving + k_stationary * seen)
-        mu = rate / f
+        mu = stiffness.rate(theta) / f
         return Spectrum(float(min(mu.min(), 0.0)), float(mu.max()), "symbol")
     ny, nx = grid.shape
     my, mx = min(ny, WINDOW[0]), min(nx, WINDOW[1])
     rows = slice((ny - my) // 2, (ny - my) // 2 + my)
     cols = slice((nx - mx) // 2, (nx - mx) // 2 + mx)
     c = compliance.restrict(rows, cols).dense()
-    w = wear_operator(grid, stroke, k_moving, k_stationary, gap_model).restrict(rows, cols).dense()
+    w = stiffness.restrict(rows, cols).dense()
     n = c.shape[0]
     # the load fixes the mean pressure: modes live in the zero-sum subspace
     q = np.linalg.qr(np.column_stack([np.ones(n), np.eye(n)[:, :n - 1]]))[0][:, 1:]
     import scipy.linalg as sla
     mu = sla.eigh(q.T @ w @ q, q.T @ c @ q, eigvals_only=True)
     return Spectrum(float(min(mu.min(), 0.0)), float(mu.max()), "window")
+
+
+def combined(spectra) -> Spectrum:
+    """The spectrum that bounds several (a load history's blocks): the fastest decay and the fastest growth."""
+    spectra = list(spectra)
+    return Spectrum(min(s.mu_min for s in spectra), max(s.mu_max for s in spectra), spectra[0].method)
 
 
 def default_linear_jump(limit: float, cycles: int) -> int:

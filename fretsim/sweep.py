@@ -276,6 +276,17 @@ def _die_with(parent: int) -> None:
     threading.Thread(target=watch, daemon=True).start()
 
 
+_RUNS = []  # this worker process's side runs: the points it runs share auto's proxies and the pilots
+
+
+def _worker_runs():
+    """The side runs of the points this process runs (one keeping per worker, silent: a sweep reports points)."""
+    if not _RUNS:
+        from fretsim.plan import SideRuns
+        _RUNS.append(SideRuns())
+    return _RUNS[0]
+
+
 def run_point(task: tuple) -> dict:
     """Run (or resume) one point, writing its results file; returns the point's status.  In a worker process."""
     global _IN_POINT
@@ -286,10 +297,10 @@ def run_point(task: tuple) -> dict:
     try:
         _IN_POINT = True
         if mode == "resume":
-            outcome = resume(output, observers=(_StopWhenTold(),))
+            outcome = resume(output, observers=(_StopWhenTold(),), runs=_worker_runs())
         else:
             case = parse_case(base_text, source=base_source, overrides=list(overrides))
-            outcome = run(case, output, overwrite=True, observers=(_StopWhenTold(),))
+            outcome = run(case, output, overwrite=True, observers=(_StopWhenTold(),), runs=_worker_runs())
         return {"name": name, "status": outcome.status, "message": outcome.message, "summary": outcome.summary}
     except KeyboardInterrupt:
         return {"name": name, "status": "interrupted", "message": "the sweep was stopped; re-run it to resume"}

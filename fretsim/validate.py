@@ -149,7 +149,7 @@ def validate(names: list[str], outdir: Path, jobs: int = 0, quick: bool = False,
         overrides = []
         if quick:
             overrides = ["model.dimension=2d"] if case.geometry.has_2d else ["loading.cycles=" +
-                                                                             str(min(case.cycles, 500))]
+                                                                             str(min(case.loading.cycles, 500))]
         tasks.append((name, tuple(overrides)))
     timing = [] if quick else [(f"table3:{i}", (case, tuple(ov))) for i, (_, case, ov, _) in enumerate(TABLE3)]
     work = tasks + [(name, ov) for _, (name, ov) in timing]

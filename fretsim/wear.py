@@ -81,35 +81,60 @@ def wear_rates(pressure: np.ndarray, dx: float, stroke: float, k_moving: float, 
             archard_depth(k_stationary, stroke_average(pressure, dx, stroke), 1.0, stroke))
 
 
+# how the flat's wear enters the gap the contact solve sees, per gap model: h_m + h_s or h_m + B h_s
+_SEEN = {"mid_stroke": lambda h_s, dx, stroke: h_s, "stroke_average": stroke_average}
+# how far the flat's wear reaches beyond the contact, in strokes: one, or two seen through the stroke average
+GAP_REACH = {"mid_stroke": 1, "stroke_average": 2, "resolved": 1}
+
+
 def gap_wear(h_moving: np.ndarray, h_stationary: np.ndarray, dx: float, stroke: float, gap_model: str) -> np.ndarray:
     """The wear the contact solve sees: h_m + h_s (mid_stroke, Eq. 18) or h_m + B h_s (stroke_average)."""
-    if gap_model == "mid_stroke":
-        return h_moving + h_stationary
-    return h_moving + stroke_average(h_stationary, dx, stroke)
+    return h_moving + _SEEN[gap_model](h_stationary, dx, stroke)
 
 
-def wear_operator(grid: Grid, stroke: float, k_moving: float, k_stationary: float, gap_model: str) -> Convolution:
+def wear_reach(dx: float, stroke: float, gap_model: str) -> int:
+    """Elements beyond the contact the wear of a gap model reaches (the contact must stay this far from the
+    grid's x edges)."""
+    return GAP_REACH[gap_model] * stroke_reach(dx, stroke)
+
+
+# the symbol of the seen wear per mode, b(θ) the stroke average's (resolved: each position sees the flat under it)
+_SYMBOL = {"mid_stroke": lambda b: b, "stroke_average": lambda b: b * b, "resolved": np.ones_like}
+# the kernel along x of the flat's seen wear per unit of its wear
+_KERNEL = {"mid_stroke": lambda w: w, "stroke_average": lambda w: np.convolve(w, w), "resolved": lambda w: np.ones(1)}
+
+
+class WearOperator(Convolution):
     """W: the growth of the gap per cycle per unit pressure, 4δ(k_m I + k_s B) or 4δ(k_m I + k_s B²); for a cycle
     resolved along the stroke (``resolved``: each position sees the flat's wear under it) the bound 4δ(k_m + k_s)I.
 
     An implicit wear step of ΔN cycles solves the contact with C + ΔN·W; the explicit update's stability is
-    set by the spectrum of the pencil (W, C).
+    set by the spectrum of the pencil (W, C) (:mod:`fretsim.stability`), for which it knows its own symbol.
     """
-    ny, nx = grid.shape
-    w = stroke_weights(grid.dx, stroke)
-    if gap_model == "stroke_average":
-        w = np.convolve(w, w)
-    elif gap_model == "resolved":
-        w = np.ones(1)
-    elif gap_model != "mid_stroke":
-        raise ValueError(f"unknown gap model {gap_model!r}; expected one of {', '.join(GAP_MODELS)}")
-    reach = (w.size - 1) // 2
-    kernel = np.zeros((2 * ny - 1, 2 * nx - 1))
-    row = kernel[ny - 1]
-    lo, hi = max(0, nx - 1 - reach), min(2 * nx - 1, nx + reach)
-    row[lo:hi] += k_stationary * w[lo - (nx - 1 - reach):hi - (nx - 1 - reach)]
-    row[nx - 1] += k_moving
-    return Convolution(grid, 4.0 * stroke * kernel)
+
+    def __init__(self, grid: Grid, stroke: float, k_moving: float, k_stationary: float, gap_model: str):
+        if gap_model not in _KERNEL:
+            raise ValueError(f"unknown gap model {gap_model!r}; expected one of {', '.join(GAP_MODELS)}")
+        ny, nx = grid.shape
+        w = _KERNEL[gap_model](stroke_weights(grid.dx, stroke))
+        reach = (w.size - 1) // 2
+        kernel = np.zeros((2 * ny - 1, 2 * nx - 1))
+        row = kernel[ny - 1]
+        lo, hi = max(0, nx - 1 - reach), min(2 * nx - 1, nx + reach)
+        row[lo:hi] += k_stationary * w[lo - (nx - 1 - reach):hi - (nx - 1 - reach)]
+        row[nx - 1] += k_moving
+        super().__init__(grid, 4.0 * stroke * kernel)
+        self.stroke, self.k_moving, self.k_stationary, self.gap_model = stroke, k_moving, k_stationary, gap_model
+
+    def rate(self, theta: np.ndarray) -> np.ndarray:
+        """W's symbol along x for modes of phase θ per element: 4δ(k_m + k_s·b(θ)), b seen as the gap model says."""
+        b = stroke_symbol(self.grid.dx, self.stroke, theta)
+        return 4.0 * self.stroke * (self.k_moving + self.k_stationary * _SYMBOL[self.gap_model](b))
+
+
+def wear_operator(grid: Grid, stroke: float, k_moving: float, k_stationary: float, gap_model: str) -> WearOperator:
+    """W on ``grid`` (:class:`WearOperator`)."""
+    return WearOperator(grid, stroke, k_moving, k_stationary, gap_model)
 
 
 # --- the flat under a moving body whose points travel differently (the resolved cycle) -----------------------------

@@ -54,7 +54,7 @@ class States:
 
 def full_cycles(name: str) -> int:
     from fretsim.case import load_case
-    return load_case(ROOT / "cases" / f"{name}.yaml").cycles
+    return load_case(ROOT / "cases" / f"{name}.yaml").loading.cycles
 
 
 def reference(name: str, dim: str, cycles: int, out: Path) -> tuple[dict, str]:

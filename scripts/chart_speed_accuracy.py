@@ -112,7 +112,7 @@ def no_jump_estimate(path: str, extra: list[str]) -> float:
     r = run_case(path, ["jumping.scheme=linear", "jumping.linear=1", f"loading.cycles={cycles}",
                         f"output.snapshots=[{cycles}]"])
     from fretsim.case import load_case
-    total = load_case(Path(__file__).resolve().parent.parent / path, extra).cycles
+    total = load_case(Path(__file__).resolve().parent.parent / path, extra).loading.cycles
     return r.seconds * total / cycles
 
 

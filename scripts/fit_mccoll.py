@@ -36,7 +36,7 @@ def main() -> None:
             csv_path = Path(tmp) / "m.csv"
             depth, width = exp["centre_wear_depth_stationary"].split(), exp["scar_width_stationary"].split()
             csv_path.write_text(f"cycle [cycles],centre_wear_depth_stationary [{depth[1]}],scar_width_stationary "
-                                f"[{width[1]}]\n{case.cycles},{depth[0]},{width[0]}\n")
+                                f"[{width[1]}]\n{case.loading.cycles},{depth[0]},{width[0]}\n")
             t = time.perf_counter()
             res = fit(text, str(path), read_measured(csv_path), overrides=["model.dimension=2d"])
             seconds = time.perf_counter() - t

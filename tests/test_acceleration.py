@@ -14,10 +14,11 @@ from fretsim.refine import coarsen, mape, refine_pressure
 from fretsim.simulate import simulate
 from fretsim.solvers import solve
 from fretsim.stability import wear_spectrum
+from fretsim.wear import wear_operator
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
 # the shipped cases that wear (the Table 1 cases are contact-only checks, cycles: 0)
-SHIPPED = sorted(p.stem for p in CASES.glob("*.yaml") if load_case(p).cycles > 0)
+SHIPPED = sorted(p.stem for p in CASES.glob("*.yaml") if load_case(p).loading.cycles > 0)
 # point contacts have no 2D model, so they get short 3D runs
 POINT = {name for name in SHIPPED if not load_case(CASES / f"{name}.yaml").geometry.has_2d}
 # service cases stop at a wear limit, their loading.cycles only an upper bound (10⁹-10¹⁰): where a test takes a
@@ -102,7 +103,7 @@ def test_bdf2_is_more_accurate_than_backward_euler_at_a_third_of_the_tolerance_w
 @pytest.mark.parametrize("body", ["moving", "stationary"])
 @pytest.mark.parametrize("name", SHIPPED)
 def test_either_body_with_a_zero_wear_coefficient_completes_with_the_default_scheme(name, body):
-    cycles = load_case(CASES / f"{name}.yaml").cycles
+    cycles = load_case(CASES / f"{name}.yaml").loading.cycles
     cycles = min(cycles, LIMITED_CYCLES) if name in LIMITED else cycles
     out = run(load_case(CASES / f"{name}.yaml", [*quick(name, cycles), f"materials.{body}.wear_coefficient=0 1/MPa"]))
     assert out.status == "complete", out.message
@@ -110,7 +111,8 @@ def test_either_body_with_a_zero_wear_coefficient_completes_with_the_default_sch
     # the paper's gap model is kept wherever it is stable on the grid, and replaced (with the reason) where not:
     # without wear of the moving body it is unstable whenever the stroke average has negative modes on the grid
     model = out.setup.cycle
-    paper = wear_spectrum(out.setup.compliance, model.stroke, model.k_moving, model.k_stationary, "mid_stroke")
+    paper = wear_spectrum(out.setup.compliance, wear_operator(out.setup.grid, model.stroke, model.k_moving,
+                                                              model.k_stationary, "mid_stroke"))
     assert model.gap_model == ("stroke_average" if paper.growth_rate > 0 else "mid_stroke")
     if body == "moving" and model.stroke > 1.5 * out.setup.grid.dx:
         assert model.gap_model == "stroke_average"

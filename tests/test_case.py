@@ -26,7 +26,7 @@ def problems_of(text, overrides=None):
 
 def test_the_issue_example_case_parses_into_internal_units():
     c = parse_case(CONTRACT)
-    assert (c.geometry.radius, c.geometry.length, c.normal_load, c.stroke, c.cycles) == (6.0, 10.0, 185.0, 0.025, 18000)
+    assert (c.geometry.radius, c.geometry.length, c.loading.peak_load, c.loading.peak_stroke, c.loading.cycles) == (6.0, 10.0, 185.0, 0.025, 18000)
     assert c.moving.youngs_modulus == 2.0e5 and c.stationary.wear_coefficient == 3.0e-8
     assert (c.dimension, c.solver, c.linear_jump, c.snapshots) == ("3d", "cg", 55, (1000, 5000, 10000, 18000))
 
@@ -126,6 +126,6 @@ def test_a_quoted_number_without_a_unit_is_called_that():
 def test_a_stroke_written_as_the_figures_print_it_is_its_amplitude():
     from pathlib import Path
     CASES = Path(__file__).resolve().parent.parent / "cases"  # noqa: N806
-    a = load_case(CASES / "mccoll_185N.yaml", ["loading.stroke=±25 um"]).stroke
-    b = load_case(CASES / "mccoll_185N.yaml", ["loading.stroke=+/-25 um"]).stroke
-    assert a == b == load_case(CASES / "mccoll_185N.yaml").stroke
+    a = load_case(CASES / "mccoll_185N.yaml", ["loading.stroke=±25 um"]).loading.peak_stroke
+    b = load_case(CASES / "mccoll_185N.yaml", ["loading.stroke=+/-25 um"]).loading.peak_stroke
+    assert a == b == load_case(CASES / "mccoll_185N.yaml").loading.peak_stroke

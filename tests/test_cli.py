@@ -97,7 +97,7 @@ def test_the_readmes_case_and_sweep_examples_are_valid_as_printed(tmp_path):
     sweep_blocks = [b for b in blocks if "axes:" in b]
     assert case_blocks and sweep_blocks
     for text in case_blocks:
-        assert parse_case(text, source="README").cycles > 0
+        assert parse_case(text, source="README").loading.cycles > 0
     cases = Path(__file__).resolve().parent.parent / "cases"
     (tmp_path / "mccoll_185N.yaml").write_text((cases / "mccoll_185N.yaml").read_text())
     for text in sweep_blocks:  # its base is relative to cases/sweeps/, where the README says it lives
@@ -230,16 +230,13 @@ def test_every_run_besides_the_runs_own_is_announced_and_a_proxy_is_not_run_twic
 
 
 def test_a_run_after_check_in_one_process_does_not_repeat_autos_proxy_runs():
-    # a notebook's check() then run(): the planning is the same, so the proxies are reused
-    import fretsim.plan as plan_module
+    # a notebook's check() then run() with one SideRuns: the planning is the same, so the proxies are reused
     from fretsim.api import check, load_case, run
+    from fretsim.plan import SideRuns
     case = load_case(CASES / "tube_RT.yaml", ["loading.cycles=20000", "grid.error_estimate=none"])
     said: list = []
-    plan_module.announce = said.append
-    try:
-        check(case)
-        checked = len(said)
-        out = run(case)
-    finally:
-        plan_module.announce = None
+    runs = SideRuns(announce=said.append)
+    check(case, runs)
+    checked = len(said)
+    out = run(case, runs=runs)
     assert checked >= 4 and len(said) == checked and out.status == "complete", said

@@ -21,6 +21,7 @@ from scipy.optimize import lsq_linear
 from fretsim.compliance import HalfSpace, add
 from fretsim.compliance.tangential import Tangential, cerruti_rectangle, datum_distance
 from fretsim.cycle import CoulombCycle, UniformCycle
+from fretsim.wear_laws import WEAR_LAWS
 from fretsim.grid import Grid
 from fretsim.reference import effective_modulus, mindlin as M
 from fretsim.solvers import solve
@@ -63,7 +64,7 @@ def cylinder_contact(n: int, load_per_length=18.5, radius=6.0, length=10.0, exte
 
 
 def fretting_cycle(grid, c, k, stroke, load, mu, volume_factor=1.0, **kw):
-    return CoulombCycle(grid, c, k, stroke, load, load * volume_factor, mu, 2e-8, 3e-8, stroke_model="mid_stroke",
+    return CoulombCycle(grid, c, k, stroke, load, load * volume_factor, mu, 2e-8, 3e-8,
                         volume_factor=volume_factor, **kw)
 
 
@@ -269,7 +270,7 @@ def test_rigid_slip_through_the_cycle_is_the_papers_stroke_average_to_round_off(
     stroke = 0.4 * a
     w = wear_operator(grid, stroke, 2e-8, 3e-8, "mid_stroke")
     paper = UniformCycle(grid, w, stroke, 18.5, 185.0, 2e-8, 3e-8, "mid_stroke")
-    ours = fretting_cycle(grid, c, k, stroke, 18.5, 0.6, volume_factor=10.0, slip="uniform")
+    ours = fretting_cycle(grid, c, k, stroke, 18.5, 0.6, volume_factor=10.0, rigid=True)
     a_cyc = paper.solve(h_m, h_s, normal, None)
     b_cyc = ours.solve(h_m, h_s, normal, None)
     scale = a_cyc.rate_stationary.max()
@@ -282,8 +283,8 @@ def test_rigid_slip_through_the_cycle_is_the_papers_stroke_average_to_round_off(
 def test_the_energy_law_is_archard_with_k_equal_alpha_mu_and_conserves_alpha_times_the_energy():
     grid, c, k, normal, a = ball_contact(40)
     mu, stroke = 0.6, 0.4 * M.ball_gross_slip_displacement(0.6, 185.0, a, BODIES)
-    archard = CoulombCycle(grid, c, k, stroke, 185.0, 185.0, mu, 2e-8 * mu, 3e-8 * mu, stroke_model="mid_stroke")
-    energy = CoulombCycle(grid, c, k, stroke, 185.0, 185.0, mu, 2e-8, 3e-8, law="energy", stroke_model="mid_stroke")
+    archard = CoulombCycle(grid, c, k, stroke, 185.0, 185.0, mu, 2e-8 * mu, 3e-8 * mu)
+    energy = CoulombCycle(grid, c, k, stroke, 185.0, 185.0, mu, 2e-8, 3e-8, law=WEAR_LAWS["energy"])
     zero = np.zeros(grid.shape)
     x, y = archard.solve(zero, zero, normal, None), energy.solve(zero, zero, normal, None)
     assert np.abs(x.rate_moving - y.rate_moving).max() <= 1e-9 * x.rate_moving.max()

@@ -207,7 +207,7 @@ def test_hostile_case_files_are_refused_quickly_with_a_short_message(tmp_path, t
 
 def test_yaml_1_2_integers_read_as_written():
     case = load_case(CASE, ["loading.cycles=017"])  # YAML 1.1 read this as octal 15
-    assert case.cycles == 17
+    assert case.loading.cycles == 17
 
 
 def test_hostile_overrides_are_refused_like_the_file():

@@ -81,8 +81,8 @@ def test_repeats_and_spectra_expand_to_exact_totals():
     c = case("loading:\n  cycles: 10000\n  repeat: 4\n  spectrum:\n"
              "    - {normal_load: 150 N, stroke: 30 um, fraction: 70 %}\n"
              "    - {normal_load: 250 N, stroke: 15 um, fraction: 0.3}\n")
-    assert c.cycles == 10000 and len(c.history()) == 8
-    assert c.normal_load == 250.0 and c.stroke == pytest.approx(0.030)
+    assert c.loading.cycles == 10000 and len(c.loading.blocks) == 8
+    assert c.loading.peak_load == 250.0 and c.loading.peak_stroke == pytest.approx(0.030)
 
 
 @pytest.mark.parametrize("loading, extra, path, words", [
@@ -123,7 +123,7 @@ def test_the_limits_cycle_matches_the_exact_per_cycle_run(loading):
         assert out.status == "complete"
         assert out.summary["limit_reached"] == "max_wear_depth_stationary"
         assert out.summary["max_wear_depth_stationary_um"] == pytest.approx(0.8, rel=2e-3)
-        assert out.summary["cycles"] < out.case.cycles  # stopped early, at the limit
+        assert out.summary["cycles"] < out.case.loading.cycles  # stopped early, at the limit
     # the depths are held to DEPTH_SHARE of the stepping tolerance, and a depth error ε moves the crossing of a
     # quantity growing as N^e by ε/e (e = d ln q / d ln N at the crossing, which the run records)
     exponent = stepped.last.limit[3]
@@ -407,7 +407,7 @@ def test_blocks_with_their_own_friction_coefficients_run_coulomb_and_keep_the_in
              "    - {normal_load: 185 N, stroke: 25 um, cycles: 2000}\n"
              "    - {normal_load: 185 N, stroke: 25 um, cycles: 2000, friction_coefficient: 0.3}\n",
              overrides=["model.slip=coulomb"])
-    assert [b.friction_coefficient for b in c.history()] == [0.9, 0.3]
+    assert [b.friction_coefficient for b in c.loading.blocks] == [0.9, 0.3]
     out = run(c)
     assert out.status == "complete", out.message
     assert out.summary["archard_volume_error"] < 1e-9

@@ -14,6 +14,11 @@ from fretsim.wear import wear_operator
 SECTION = 0.03
 
 
+
+def _spectrum(op, stroke, k_moving, k_stationary, gap_model, general=False):
+    """The explicit update's spectrum for a half-space and the uniform cycle's W on its grid."""
+    return wear_spectrum(op, wear_operator(op.grid, stroke, k_moving, k_stationary, gap_model), general)
+
 def _zero_sum_min_eig(dense):
     n = dense.shape[0]
     q = np.linalg.qr(np.column_stack([np.ones(n), np.eye(n)[:, :n - 1]]))[0][:, 1:]
@@ -34,8 +39,8 @@ def test_symbol_at_nyquist_matches_smallest_eigenvalue_of_the_dense_operator(gri
                                   Grid.centred(101, 9, 0.00628, 10 / 9)], ids=["2d", "3d"])
 def test_general_window_method_agrees_with_the_closed_form_for_the_half_space(grid, gap_model):
     op = HalfSpace(grid, E_STAR)
-    fast = wear_spectrum(op, 0.025, 2e-8, 3e-8, gap_model)
-    general = wear_spectrum(op, 0.025, 2e-8, 3e-8, gap_model, general=True)
+    fast = _spectrum(op, 0.025, 2e-8, 3e-8, gap_model)
+    general = _spectrum(op, 0.025, 2e-8, 3e-8, gap_model, general=True)
     assert fast.method == "symbol" and general.method == "window"
     assert general.limit >= fast.limit * (1 - 1e-6)  # a finite section is never less stable than the lattice
     assert general.limit == pytest.approx(fast.limit, rel=SECTION)
@@ -46,21 +51,21 @@ def test_limit_of_an_added_compliance_is_computed_for_the_sum():
     grid = Grid.centred(101, 1, 0.00628, 1.0, plane_strain=True)
     hs = HalfSpace(grid, E_STAR)
     extra = Matrix(grid, 0.2 * np.diag(np.diag(hs.dense())))
-    base = wear_spectrum(hs, 0.025, 2e-8, 3e-8, "mid_stroke", general=True).limit
-    softer = wear_spectrum(Sum(hs, extra), 0.025, 2e-8, 3e-8, "mid_stroke").limit
+    base = _spectrum(hs, 0.025, 2e-8, 3e-8, "mid_stroke", general=True).limit
+    softer = _spectrum(Sum(hs, extra), 0.025, 2e-8, 3e-8, "mid_stroke").limit
     assert softer > 1.05 * base
 
 
 def test_stability_limit_of_the_2d_185N_case_lies_between_the_stable_42_and_the_unstable_50():
     # measured (issue #9): linear jumps of 42 cycles finish, 50 checkerboard, on the 185 N case's 2D grid
-    limit = wear_spectrum(HalfSpace(Grid.centred(161, 1, 0.00628, 1.0, True), E_STAR), 0.025, 2e-8, 3e-8,
+    limit = _spectrum(HalfSpace(Grid.centred(161, 1, 0.00628, 1.0, True), E_STAR), 0.025, 2e-8, 3e-8,
                           "mid_stroke").limit
     assert 42 < limit < 50
 
 
 def test_stability_limit_scales_with_element_size_and_wear_rate():
     def limit(dx, km, ks):
-        return wear_spectrum(HalfSpace(Grid.centred(161, 1, dx, 1.0, True), E_STAR), 0.025, km, ks,
+        return _spectrum(HalfSpace(Grid.centred(161, 1, dx, 1.0, True), E_STAR), 0.025, km, ks,
                              "mid_stroke").limit
     base = limit(0.00625, 2e-8, 3e-8)
     assert limit(0.0125, 2e-8, 3e-8) > 1.5 * base  # coarser → larger
@@ -70,11 +75,11 @@ def test_stability_limit_scales_with_element_size_and_wear_rate():
 def test_papers_gap_model_is_unstable_when_the_moving_body_does_not_wear_and_the_stroke_average_is_not():
     grid = Grid.centred(161, 1, 0.00628, 1.0, True)
     op = HalfSpace(grid, E_STAR)
-    paper = wear_spectrum(op, 0.025, 0.0, 3e-8, "mid_stroke")
-    averaged = wear_spectrum(op, 0.025, 0.0, 3e-8, "stroke_average")
+    paper = _spectrum(op, 0.025, 0.0, 3e-8, "mid_stroke")
+    averaged = _spectrum(op, 0.025, 0.0, 3e-8, "stroke_average")
     assert paper.growth_rate > 0 and averaged.growth_rate == 0
     # and with the paper's coefficients (k_m = 2e-8 ≥ 0.22 k_s) both are stable
-    assert wear_spectrum(op, 0.025, 2e-8, 3e-8, "mid_stroke").growth_rate == 0
+    assert _spectrum(op, 0.025, 2e-8, 3e-8, "mid_stroke").growth_rate == 0
 
 
 @pytest.mark.parametrize("k_moving", [0.0, 2e-8])

@@ -6,7 +6,7 @@ each body's slip distance per cycle at each point, the shear traction, the dissi
 cycle of both bodies.  The loop (:mod:`fretsim.simulate`) only steps the wear with these rates; the stepping
 schemes never see the physics of the cycle.
 
-Members (chosen by ``model.slip``):
+Members (chosen by ``model.slip``; ``model.stroke`` says where the normal contact is solved):
 
 * ``uniform`` (:mod:`.uniform`): the paper's model — pressure solved once at mid-stroke, every point slides 4δ,
   the flat wears with the stroke-averaged pressure (Eqs. 15–16).  Its rates are linear in the pressure, so the
@@ -16,8 +16,10 @@ Members (chosen by ``model.slip``):
   depend on the slip, which depends on the pressure: the implicit steps use a linear operator that bounds its
   stiffness and report the mismatch (``Cycle.defect``).  Invariant: wear volume k·Σ p·|ds|·A per cycle.
 
-Every member has the same small interface (:class:`FrettingCycle`); the registry :data:`CYCLES` maps names to
-builders, and tests loop over it.
+Every member has the same small interface (:class:`FrettingCycle`) and builds itself from a :class:`CycleSpec`
+(one block of the loading on the run's grid, its operators and wear law); the registry :data:`CYCLES` maps the
+names a case may give to the members, the case reader validates ``model.slip`` against it, the planner builds
+through :func:`build`, and the tests loop over it.  A new member is one module here and one registry line.
 """
 from __future__ import annotations
 
@@ -26,6 +28,8 @@ from typing import Callable, Optional, Protocol
 
 import numpy as np
 
+from fretsim.grid import Grid
+from fretsim.loading import Block
 from fretsim.solvers.result import ContactResult
 
 REGIMES = ("partial_slip", "gross_slip")
@@ -72,11 +76,23 @@ class FrettingCycle(Protocol):
     name: str
     linear: bool  # wear rates linear in the mid-stroke pressure: implicit steps are exact
     invariant: str  # the conserved quantity, for messages
+    closed_form: bool  # the invariant is k·P·4δ·N itself (summed over a load history's blocks), not the work
+    singular_pressure: bool  # the model's own pressure has element-scale peaks: no ceiling on the checkerboard
+    gap_model: str  # how the flat's wear enters the mid-stroke gap ("–": not at mid-stroke)
+    needs_friction: bool  # the member resolves the shear traction: loading.friction_coefficient is required
+    assumes_gross_slip: bool  # every point slides: refused where the contact partly sticks
+
+    @classmethod
+    def build(cls, spec: "CycleSpec") -> "FrettingCycle":
+        """The member for one block of the loading."""
 
     def solve(self, wear_moving: np.ndarray, wear_stationary: np.ndarray, normal: Normal,
               guess: Optional[np.ndarray], step: float = 0.0, memory: Optional[dict] = None,
               cycle: int = 0, detail: bool = True) -> Cycle:
         """``detail``: the state will be recorded, so draw what is only drawn (the loop's shape) in full."""
+
+    def describe(self) -> str:
+        """The cycle model in a few words, for a run's one-paragraph summary."""
 
     def stiffness(self):
         """An operator W (gap growth per cycle per unit pressure, on the solve grid) whose spectrum bounds the
@@ -91,7 +107,27 @@ class FrettingCycle(Protocol):
         """(moving, stationary) wear volumes (mm³) the invariant demands after ``cycles`` with accumulated
         ``work``."""
 
-    # a linear member also rebuilds the cycle of a checkpoint's pressure without solving: restore(pressure)
+    def restore(self, pressure: np.ndarray) -> Cycle:
+        """A linear member rebuilds the cycle of a checkpoint's pressure without solving (others solve again)."""
+
+
+@dataclass(frozen=True)
+class CycleSpec:
+    """What a member is built from: one block of the loading on the run's grids, with its operators."""
+
+    grid: Grid  # the fine grid (wear, rates)
+    solve_grid: Grid  # the grid the normal contact is solved on (coarser with refinement, Eqs. 11-12)
+    compliance: object  # the normal operator C on ``grid``
+    tangential: object  # both bodies' tangential compliance K on ``grid`` (None without a friction coefficient)
+    block: Block  # the load, stroke and μ
+    load: float  # the block's load on the grid: N (3D) or N/mm (2D)
+    law: object  # the wear law (fretsim.wear_laws)
+    moving: object  # the bodies' materials (their wear-law coefficients)
+    stationary: object
+    gap_model: str  # how the flat's wear enters the mid-stroke gap (fretsim.wear)
+    resolved: bool  # the normal contact solved at each increment of the stroke (model.stroke resolved)
+    increments: int  # per half-stroke
+    volume_factor: float  # the line length in 2D: grid volumes and forces → totals
 
 
 def stick_half_width(stick_row: np.ndarray, x: np.ndarray, dx: float) -> float:
@@ -108,3 +144,25 @@ from fretsim.cycle.coulomb import CoulombCycle  # noqa: E402 - the members need 
 from fretsim.cycle.uniform import UniformCycle  # noqa: E402
 
 CYCLES: dict[str, type] = {"uniform": UniformCycle, "coulomb": CoulombCycle}
+PAPER = "uniform"  # the paper's member: what auto keeps where gross slip is assumed or within model.accuracy
+FRICTION = "coulomb"  # the member that resolves friction: what auto takes where the paper's is not accurate enough
+# model.stroke: where the normal contact is solved — once at mid-stroke (the paper), or at each increment
+STROKES: dict[str, bool] = {"mid_stroke": False, "resolved": True}
+MID_STROKE = "mid_stroke"
+
+
+def build(slip: str, stroke: str, spec_fields: dict) -> FrettingCycle:
+    """The member ``slip`` (a name in :data:`CYCLES`) for one block, the contact solved as ``stroke`` says."""
+    return CYCLES[slip].build(CycleSpec(resolved=STROKES[stroke], **spec_fields))
+
+
+def friction_needed(slip: str, stroke: str, law) -> Optional[str]:
+    """Why a case's model needs loading.friction_coefficient (None if it does not): a member that resolves the
+    shear traction, a wear law of the friction's energy, or a resolved stroke (the traction μp it reports)."""
+    if slip in CYCLES and CYCLES[slip].needs_friction:
+        return f"model.slip {slip}"
+    if law is not None and law.needs_friction:
+        return f"model.wear_law {law.name} ({law.formula})"
+    if STROKES.get(stroke):
+        return f"model.stroke {stroke} (the shear traction μp it reports at each increment)"
+    return None

@@ -43,10 +43,11 @@ from typing import Optional
 import numpy as np
 
 from fretsim.compliance import scaled
-from fretsim.cycle import Cycle, CycleError, stick_half_width
+from fretsim.cycle import Cycle, CycleError, CycleSpec, stick_half_width
 from fretsim.grid import Grid
 from fretsim.solvers.tangential import solve_tangential
 from fretsim.wear import gap_wear, sweep_deposit, sweep_read, wear_operator
+from fretsim.wear_laws import WEAR_LAWS, WearLaw, coefficients
 
 CORRECTIONS = 1  # fixed-point corrections of an implicit step's gap for the wear its cycle really found: the
 #                 linearised step alone is first-order in the step (its bias ∝ the step), one correction cuts the
@@ -67,43 +68,60 @@ class CoulombCycle:
     load: float  # on the grid: N (3D) or N/mm (2D)
     total_load: float  # N
     friction_coefficient: float
-    k_moving: float  # Archard's k, or α of the energy law (1/MPa = mm³/(N·mm))
+    k_moving: float  # the wear law's coefficients (Archard's k, or α of the energy law: 1/MPa = mm³/(N·mm))
     k_stationary: float
-    law: str = "archard"
-    slip: str = "coulomb"  # coulomb | uniform (rigid tangentially: every point slides with the rig)
-    stroke_model: str = "mid_stroke"
-    gap_model: str = "mid_stroke"  # stroke_model mid_stroke: how the flat's wear enters the mid-stroke gap
+    law: WearLaw = WEAR_LAWS["archard"]
+    rigid: bool = False  # bodies rigid tangentially: every point slides with the rig (model.slip uniform)
+    resolved: bool = False  # the normal contact solved at each increment, over the worn flat (model.stroke resolved)
+    gap_model: str = "mid_stroke"  # at mid-stroke: how the flat's wear enters the mid-stroke gap
     increments: int = 9  # per half-stroke; odd, so that one is centred on mid-stroke
     volume_factor: float = 1.0  # the line length in 2D: grid volumes and forces → totals
     tolerance: float = 1e-10  # the tangential solver's
     name: str = "coulomb"
     linear: bool = False
+    closed_form = False
+    needs_friction = True
+    assumes_gross_slip = False
+
+    @classmethod
+    def build(cls, spec: CycleSpec, rigid: bool = False):
+        """The incremental cycle for one block (``rigid``: uniform slip resolved along the stroke)."""
+        block = spec.block
+        k_m, k_s = coefficients(spec.law, spec.moving, spec.stationary)
+        return cls(grid=spec.grid, compliance=spec.compliance, tangential=spec.tangential, stroke=block.stroke,
+                   load=spec.load, total_load=block.normal_load, friction_coefficient=block.friction_coefficient,
+                   k_moving=k_m, k_stationary=k_s, law=spec.law, rigid=rigid, resolved=spec.resolved,
+                   gap_model=spec.gap_model, increments=spec.increments, volume_factor=spec.volume_factor)
 
     @property
     def kernel(self) -> str:
         """How the flat is read and receives wear along a point's travel (fretsim.wear.sweep_deposit)."""
-        return "hat" if self.stroke_model == "resolved" else "box"
+        return "hat" if self.resolved else "box"
 
     @property
     def singular_pressure(self) -> bool:
         """A resolved stroke wears kinks into both bodies where the contact's edges turn at the stroke's ends; the
         pressure has (log-)singular peaks there, element-scale on any grid (README: the resolved stroke)."""
-        return self.stroke_model == "resolved"
+        return self.resolved
 
     @property
     def invariant(self) -> str:
-        return "k·Σp·|ds|·A" if self.law == "archard" else "α·ΣW"
+        return self.law.invariant
 
     # -- the linear operator the implicit steps use, and the explicit stability limit's bound --------------------
     @cached_property
     def _w_unit(self):
         """W at a slip of 4δ everywhere, with the coefficients of p·|ds| (α·μ for the energy law)."""
-        c = self.friction_coefficient if self.law == "energy" else 1.0
+        c = self.law.gross_slip_factor(self.friction_coefficient)
         return wear_operator(self.grid, self.stroke, c * self.k_moving, c * self.k_stationary,
-                             "resolved" if self.stroke_model == "resolved" else self.gap_model)
+                             "resolved" if self.resolved else self.gap_model)
 
     def stiffness(self):
         return self._w_unit
+
+    def describe(self) -> str:
+        return (f"{'uniform' if self.rigid else 'coulomb'} slip, stroke {'resolved' if self.resolved else 'mid-stroke'}, "
+                f"{self.increments} increments per half-stroke")
 
     @property
     def bounds(self) -> tuple[float, float]:
@@ -114,7 +132,7 @@ class CoulombCycle:
         tangential solve got wrong breaks them."""
         travel = 4.0 * self.stroke * self.total_load
         mu = self.friction_coefficient
-        return (travel if self.law == "archard" else mu * travel), mu * travel
+        return self.law.gross_slip_factor(mu) * travel, mu * travel
 
     def expected_volumes(self, cycles: int, work: float) -> tuple[float, float]:
         return self.k_moving * work, self.k_stationary * work
@@ -134,7 +152,7 @@ class CoulombCycle:
         """One cycle; an implicit step's (``step`` > 0) corrected CORRECTIONS times for its linearisation."""
         cyc = self._solve(wear_moving, wear_stationary, normal, guess, step, memory, cycle, detail)
         uneven = float((memory or {}).get("slip_spread", 1.0)) > SPREAD_TO_CORRECT
-        for _ in range(CORRECTIONS if step and uneven and self.stroke_model != "resolved" else 0):
+        for _ in range(CORRECTIONS if step and uneven and not self.resolved else 0):
             cyc = self._solve(wear_moving, wear_stationary, normal, cyc.pressure, step, memory, cycle, detail,
                               correction=cyc.mismatch)
         return cyc
@@ -146,12 +164,12 @@ class CoulombCycle:
         recorded state), each half-stroke is taken in one increment — the same wear, slips, energy and regime."""
         g, dx = self.grid, self.grid.dx
         mu = self.friction_coefficient
-        n = self.increments if detail or self.stroke_model == "resolved" else 1
+        n = self.increments if detail or self.resolved else 1
         area = g.area * self.volume_factor
         slip_lin = float((memory or {}).get("slip_lin", 4.0 * self.stroke))
         w_lin = scaled(self._w_unit, slip_lin / (4.0 * self.stroke)) if step else None
         extra = scaled(w_lin, step) if step else None
-        resolved = self.stroke_model == "resolved"
+        resolved = self.resolved
         if not resolved:
             seen = gap_wear(wear_moving, wear_stationary, dx, self.stroke, self.gap_model)
             if correction is not None:
@@ -173,7 +191,7 @@ class CoulombCycle:
                 loop_q.append(float(q.sum()) * area)
             du = u1 - u0
             if resolved:
-                same_way = ds_prev is not None and du * du_prev > 0 and self.slip == "coulomb"
+                same_way = ds_prev is not None and du * du_prev > 0 and not self.rigid
                 ds_guess = ds_prev * (du / du_prev) if same_way else np.full(shape, du)
                 p, res = normal(wear_moving + sweep_read(wear_stationary, s, s + ds_guess, dx, self.kernel), p_prev, extra,
                                 load=self.load, cycle=cycle)
@@ -182,7 +200,7 @@ class CoulombCycle:
                 p, res, ds_guess = p_fixed, res_fixed, None
             q_new, ds, stuck, its = self._tangential(q, p, du)
             iterations += its
-            if resolved and self.slip == "coulomb":
+            if resolved and not self.rigid:
                 off = np.abs(ds - ds_guess)[p > 0]
                 if off.size and off.max() > TRAVEL_TOLERANCE * dx:  # solve again where the points really went
                     ds_guess = ds
@@ -191,7 +209,7 @@ class CoulombCycle:
                     q_new, ds, stuck, its = self._tangential(q, p, du)
                     iterations += res.iterations + its
             if counted:
-                amount = p * np.abs(ds) if self.law == "archard" else np.abs(q_new) * np.abs(ds)
+                amount = self.law.amount(p, q_new, ds)
                 rate_m += self.k_moving * amount
                 rate_s += self.k_stationary * sweep_deposit(amount, s, s + ds, dx, self.kernel)
                 slip_m += np.abs(ds)
@@ -232,7 +250,7 @@ class CoulombCycle:
 
     def _tangential(self, q, p, du):
         """One increment's traction, slip and stick set; rigid bodies (``slip: uniform``) slide with the rig."""
-        if self.slip == "uniform":
+        if self.rigid:
             on = p > 0
             return np.where(on, np.sign(du) * self.friction_coefficient * p, 0.0), np.where(on, du, 0.0), \
                 np.zeros(p.shape, bool), 0

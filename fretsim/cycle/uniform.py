@@ -15,10 +15,11 @@ from typing import Optional
 import numpy as np
 
 from fretsim.compliance import scaled
-from fretsim.cycle import Cycle
+from fretsim.cycle import Cycle, CycleSpec
 from fretsim.grid import Grid
 from fretsim.solvers.result import ContactResult
-from fretsim.wear import archard_volume, gap_wear, stroke_average, wear_rates
+from fretsim.wear import archard_volume, gap_wear, stroke_average, wear_operator, wear_rates
+from fretsim.wear_laws import gross_slip_coefficients
 
 
 @dataclass(frozen=True)
@@ -38,6 +39,24 @@ class UniformCycle:
     name: str = "uniform"
     linear: bool = True
     invariant: str = "k·P·4δ·N"
+    closed_form = True  # its invariant is k·P·4δ·N itself (summed over a load history's blocks)
+    singular_pressure = False
+    needs_friction = False
+    assumes_gross_slip = True
+
+    @classmethod
+    def build(cls, spec: CycleSpec):
+        """The paper's cycle for one block; with the stroke resolved, the incremental cycle with bodies rigid
+        tangentially (every point slides with the rig), which is uniform slip at each position."""
+        if spec.resolved:
+            from fretsim.cycle.coulomb import CoulombCycle
+            return CoulombCycle.build(spec, rigid=True)
+        block = spec.block
+        mu = block.friction_coefficient
+        k_m, k_s = gross_slip_coefficients(spec.law, spec.moving, spec.stationary, mu)
+        return cls(grid=spec.grid, wear_op=wear_operator(spec.solve_grid, block.stroke, k_m, k_s, spec.gap_model),
+                   stroke=block.stroke, load=spec.load, total_load=block.normal_load, k_moving=k_m, k_stationary=k_s,
+                   gap_model=spec.gap_model, friction_coefficient=mu)
 
     def rates(self, pressure: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
         """Wear per cycle of the moving and the stationary body for the mid-stroke pressure (Eqs. 15–16)."""
@@ -45,6 +64,9 @@ class UniformCycle:
 
     def stiffness(self):
         return self.wear_op
+
+    def describe(self) -> str:
+        return f"gap model {self.gap_model}"
 
     def solve(self, wear_moving, wear_stationary, normal, guess, step: float = 0.0, memory=None,
               cycle: int = 0, detail: bool = True) -> Cycle:
@@ -78,8 +100,6 @@ class UniformCycle:
         mu = self.friction_coefficient
         return self.total_load * 4.0 * self.stroke, (mu * self.total_load * 4.0 * self.stroke if mu is not None
                                                       else float("inf"))
-
-    closed_form = True  # its invariant is k·P·4δ·N itself (summed over a load history's blocks)
 
     def expected_volumes(self, cycles: int, work: float) -> tuple[float, float]:
         # closed form, not the accumulated work: the paper's invariant exactly

@@ -1,0 +1,99 @@
+"""The plan of a run: every automatic decision, each a small function returning its value and its reason.
+
+:func:`prepare` turns a validated :class:`~fretsim.case.Case` into the loop's :class:`~fretsim.simulate.Setup`
+(arrays, numbers, operators) and a *filled* case in which every automatic choice is written out, so the run
+can be repeated — or resumed — exactly.  It reads as its stages, in order, each a module of this package:
+
+1. :mod:`.inputs` — plausible input, the elastic model's range, the unworn contact;
+2. :mod:`.model` (its pilot) — the cycles a run with wear limits is sized for;
+3. :mod:`.grid` — the domain, the elements, the recorded states, the memory;
+4. :mod:`.model` — the dimension, the corrections and the gap model (auto's proxies), and their operators;
+5. :mod:`.cycle` — the regime of every block and the fretting-cycle member (a partial-slip contact sends the
+   planner back to 3 on a finer grid), then the member built by its family for each block;
+6. :mod:`.stepping` — the stability limit from the members' stiffness, the scheme, its jumps and caps;
+7. :mod:`.cost` — the solves and seconds the run will take (for ``check`` and the progress bar).
+
+The list of :class:`Choice` is stored in the results file (``/choices``) and printed by ``fretsim check``;
+choices the case made itself are listed too, as "given".
+"""
+from __future__ import annotations
+
+import functools
+from typing import Optional
+
+from fretsim.case import Case
+from fretsim.plan import cycle, grid, inputs, model, stepping
+from fretsim.plan.choices import Choice, Plan, show
+from fretsim.plan.cost import estimate_cost, estimate_solves
+from fretsim.plan.model import available_corrections
+from fretsim.plan.runs import SideRuns
+from fretsim.simulate import Setup
+from fretsim.stepping.implicit import DEPTH_SHARE
+from fretsim.wear import wear_reach
+
+__all__ = ["Choice", "Plan", "SideRuns", "available_corrections", "estimate_cost", "estimate_solves", "prepare",
+           "show"]
+
+
+def prepare(case: Case, allow_unstable: bool = False, runs: Optional[SideRuns] = None, *,
+            pilot: Optional[float] = None) -> tuple[Setup, Case, Plan]:
+    """Unpack a case into arrays and numbers; fill the automatic choices into the returned case.
+
+    A linear jump beyond the explicit stability limit is refused (CaseError) unless ``allow_unstable`` (for
+    studies of the instability itself); so is the paper's gap model where it is unstable over the run.  ``runs``
+    announces the runs planning makes besides the run (auto's proxies, a pilot) and keeps their results for the
+    next plan in its keeping; ``pilot`` is a pilot's result already known (NaN: none is to be run).
+    """
+    runs = runs if runs is not None else SideRuns()
+    plan_case = functools.partial(prepare, runs=runs)
+    plan = Plan()
+    case = inputs.tighten_for_pressure(case, plan)
+    contact = inputs.contact(case, plan)
+    sized = model.cycles_to_size(case, plan, runs, plan_case, pilot)
+    # auto's proxies compare the models' depths and widths: at a limit the limited one is pinned, so they run
+    # without the limits, over the cycles the run will take
+    proxy_case = case.with_choices(limits=(), loading=case.loading.with_cycles(sized)) if case.limits else case
+    start, refine = plan.copy(), 1.0
+    while True:  # twice at most: a partial-slip contact is planned again on the grid it needs
+        plan = start.copy()
+        dimension = plan.add(model.choose_dimension(proxy_case, contact.e_star, runs, plan_case))
+        grids = grid.build(case, plan, contact, dimension, sized, refine)
+        operators = model.build(case, plan, grids, contact.e_star, proxy_case, runs, plan_case)
+        regime = cycle.regime(case, grids.grid, operators.compliance)
+        finer = grid.refined(case, regime.slip.value, regime.transition, contact, refine)
+        if finer is None:
+            break
+        refine = finer
+    grid.warn_unresolved_stick(case, plan, regime.slip.value, regime.transition, contact, grids.grid)
+    cycles = cycle.build(case, plan, grids, operators, regime)
+    steps = stepping.build(case, plan, grids, operators, cycles, allow_unstable)
+    return _setup(case, plan, grids, operators, regime, cycles, steps), _filled(case, grids, operators, cycles,
+                                                                                 steps), plan
+
+
+def _setup(case: Case, plan: Plan, grids, operators, regime, cycles, steps) -> Setup:
+    """The loop's setup: arrays, numbers, operators, the loading and the members."""
+    g, members = case.geometry, cycles.members
+    first = members[0]
+    return Setup(grid=grids.grid, compliance=operators.compliance, gap=g.separation(grids.grid),
+                 loading=case.loading, cycle=first, block_cycles=members if len(members) > 1 else (),
+                 wear_limits=dict(case.limits), wall=getattr(g, "wall", None) if case.limits else None,
+                 limit_tolerance=case.step_tolerance * DEPTH_SHARE, frequency=case.loading.frequency,
+                 band=wear_reach(grids.grid.dx, case.loading.peak_stroke, first.stiffness().gap_model) + 1,
+                 scheme=steps.scheme, linear_jump=steps.linear_jump, stability_limit=steps.limit,
+                 method=case.solver, tolerance=case.tolerance, snapshots=steps.snapshots,
+                 volume_factor=g.line_length if grids.plane else 1.0, limits=g.limits, y_edges_free=g.y_edges_free,
+                 eta=case.eta, max_jump=steps.max_jump, step_tolerance=case.step_tolerance,
+                 implicit_cap=steps.implicit_cap, coarse=grids.coarse, coarse_compliance=operators.coarse_compliance,
+                 coarse_gap=operators.coarse_gap, per_cycle=steps.per_cycle,
+                 gross_slip_stroke=regime.transition if regime.transition is not None else float("nan"),
+                 notes=tuple(f"{c.key} = {show(c.value)}: {c.reason}" for c in plan.choices if not c.given)
+                 + tuple(plan.warnings))
+
+
+def _filled(case: Case, grids, operators, cycles, steps) -> Case:
+    """The case with every automatic choice written out: it runs again (or resumes) exactly."""
+    return case.with_choices(dimension=grids.dimension, corrections=operators.corrections or "none",
+                             domain=grids.domain, elements=grids.elements, gap_model=operators.gap_model,
+                             scheme=steps.scheme, slip=cycles.slip, stroke_model=cycles.stroke_model,
+                             linear_jump=steps.linear_jump, max_jump=steps.max_jump, snapshots=steps.snapshots)

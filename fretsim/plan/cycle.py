@@ -1,0 +1,189 @@
+"""The planner's cycle stage: the fretting regime of every block, the fretting-cycle member that models it and
+where the normal contact is solved, then the member built by its family for each block of the loading.
+
+The regime follows from the unworn contact: gross slip needs the stroke to exceed δ_t, the rig displacement
+at which the last point starts to slide (δ_t = max K·μp: every point then carries μp; with the rig's 1/k
+included).  A load history's regime is that of its block nearest partial slip.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Optional
+
+from fretsim import cycle as family
+from fretsim.case import Case, CaseError
+from fretsim.cycle import CYCLES, STROKES
+from fretsim.cycle.coulomb import gross_slip_stroke
+from fretsim.grid import Grid
+from fretsim.loading import Block
+from fretsim.plan.choices import Choice, Plan
+from fretsim.solvers import solve
+
+
+@dataclass(frozen=True)
+class Regime:
+    """The regime of the unworn contact: the tangential operator, δ_t and the block it was judged on."""
+
+    tangential: object  # K on the run's grid (None without any friction coefficient)
+    transition: Optional[float]  # δ_t of the block nearest partial slip (mm; None without μ)
+    block: Block  # the block nearest partial slip (the first without μ)
+    slip: Choice
+
+
+@dataclass(frozen=True)
+class Cycles:
+    """The cycle stage's result: the member's name, where the contact is solved, a member per block."""
+
+    slip: str
+    stroke_model: str
+    members: tuple  # one per block of the loading, in the order applied (a repeated block shares its member)
+
+
+def tangential_operator(case: Case, grid: Grid):
+    """Both bodies' tangential compliance on the grid, the 2D datum and the rig's compliance
+    (:mod:`fretsim.compliance.tangential`)."""
+    from fretsim.compliance.tangential import Tangential
+    plane = grid.plane_strain
+    volume_factor = case.geometry.line_length if plane else 1.0
+    k_t = case.loading.tangential_stiffness
+    rig = grid.area * volume_factor / k_t if k_t else 0.0
+    bodies = [(m.youngs_modulus, m.poissons_ratio) for m in (case.moving, case.stationary)]
+    return Tangential(grid, bodies, case.geometry.line_length if plane else None, rig)
+
+
+def grid_load(case: Case, grid: Grid, normal_load: float) -> float:
+    """A load on the grid: N in 3D, N/mm (over the line length) in 2D."""
+    return normal_load / case.geometry.line_length if grid.plane_strain else normal_load
+
+
+def regime(case: Case, grid: Grid, compliance) -> Regime:
+    """The unworn contact's regime on the run's grid: each distinct block with a μ solved once, the one whose
+    stroke is nearest δ_t kept."""
+    blocks = case.loading.blocks
+    tangential = transition = None
+    nearest = blocks[0]
+    if any(b.friction_coefficient is not None for b in blocks):
+        tangential = tangential_operator(case, grid)
+        worst = None
+        for b in dict.fromkeys(blocks):
+            if b.friction_coefficient is None:
+                continue
+            p_b = solve(compliance, case.geometry.separation(grid), grid_load(case, grid, b.normal_load),
+                        tol=case.tolerance).pressure
+            t_b = gross_slip_stroke(tangential, p_b, b.friction_coefficient)
+            if worst is None or t_b / b.stroke > worst[0]:
+                worst = (t_b / b.stroke, t_b, b)
+        _, transition, nearest = worst
+    return Regime(tangential, transition, nearest, choose_slip(case, nearest, transition))
+
+
+def choose_slip(case: Case, block: Block, transition: Optional[float]) -> Choice:
+    """The fretting-cycle member: the paper's uniform gross slip, or friction resolved through the cycle.
+
+    Below δ_t the contact partly sticks and a member that assumes gross slip is refused.  Above it every point
+    still slides less than the rig by its elastic tangential displacement, at most δ_t: uniform slip
+    overestimates the slip, and so the wear, by up to δ_t/δ; auto keeps the paper's member only where that is
+    within model.accuracy.
+    """
+    mu, stroke = block.friction_coefficient, block.stroke
+    given = CYCLES.get(case.slip)  # None: auto
+    if transition is not None and (given is None or given.assumes_gross_slip) and stroke <= transition:
+        if given is not None:
+            raise CaseError(case.source, [("model.slip", f"{case.slip} slip is refused here: the stroke "
+                                                         f"{stroke * 1e3:.4g} µm is within the partial-slip "
+                                                         f"limit δ_t = {transition * 1e3:.4g} µm for μ = {mu:g}, so "
+                                                         f"the contact partly sticks and uniform slip (4δ at every "
+                                                         f"point) would overestimate the wear; use model.slip: "
+                                                         f"{family.FRICTION} (or auto)")])
+        return Choice("model.slip", family.FRICTION, f"partial slip: the stroke {stroke * 1e3:.4g} µm is within the "
+                                                     f"gross-slip limit δ_t = {transition * 1e3:.4g} µm (μ = {mu:g}): "
+                                                     f"the centre sticks and only the slip annulus wears")
+    if given is not None:
+        return Choice("model.slip", case.slip, "given in the case", True)
+    if mu is None:
+        return Choice("model.slip", family.PAPER, "no friction coefficient: the paper's gross slip is assumed (give "
+                                                  "loading.friction_coefficient to judge the regime)")
+    deficit = transition / stroke
+    if deficit > case.accuracy:
+        return Choice("model.slip", family.FRICTION, f"gross slip (the stroke is {1 / deficit:.1f}× the limit δ_t = "
+                                                     f"{transition * 1e3:.4g} µm), but the bodies' elastic tangential "
+                                                     f"displacement takes up to δ_t/δ = {deficit:.1%} of the slip, "
+                                                     f"more than model.accuracy {case.accuracy:.1%}: Coulomb friction "
+                                                     f"through the cycle")
+    return Choice("model.slip", family.PAPER, f"gross slip far above the limit: the stroke is {1 / deficit:.0f}× "
+                                              f"δ_t = {transition * 1e3:.4g} µm, so uniform slip overestimates the "
+                                              f"slip by at most δ_t/δ = {deficit:.2%}, within model.accuracy "
+                                              f"{case.accuracy:.1%}", error=deficit)
+
+
+def choose_stroke(case: Case, slip: str) -> Choice:
+    """mid_stroke (one normal solve per cycle, the paper's) or resolved (one per increment, at each position)."""
+    if case.stroke_model != "auto":
+        return Choice("model.stroke", case.stroke_model, "given in the case", True)
+    if CYCLES[slip].assumes_gross_slip:
+        return Choice("model.stroke", family.MID_STROKE, "the paper's: the pressure solved at mid-stroke, the flat "
+                                                         "wearing with its stroke average")
+    return Choice("model.stroke", family.MID_STROKE, "Mindlin's setting: the normal contact at mid-stroke held "
+                                                     "through the cycle, each point's slip and traction resolved in "
+                                                     "increments (a resolved stroke wears kinks where the contact's "
+                                                     "edges turn at the stroke's ends: README)")
+
+
+def build(case: Case, plan: Plan, grids, model, regime_: Regime) -> Cycles:
+    """The member and the stroke model recorded, then a member for each block of the loading."""
+    slip = plan.add(regime_.slip)
+    stroke_model = plan.add(choose_stroke(case, slip))
+    grid = grids.grid
+    built: dict = {}  # a repeated block shares its member (and its cached operators)
+
+    def member(block: Block):
+        return family.build(slip, stroke_model, dict(
+            grid=grid, solve_grid=model.solve_compliance.grid, compliance=model.compliance,
+            tangential=regime_.tangential, block=block, load=grid_load(case, grid, block.normal_load),
+            law=case.law, moving=case.moving, stationary=case.stationary, gap_model=model.gap_model,
+            increments=case.increments, volume_factor=case.geometry.line_length if grid.plane_strain else 1.0))
+
+    members = tuple(built.setdefault(b, member(b)) for b in case.loading.blocks)
+    if not members[0].linear:
+        _check_incremental(case, grids, model, plan, regime_.transition)
+    if STROKES[stroke_model]:
+        _warn_resolved(case, plan)
+    return Cycles(slip, stroke_model, members)
+
+
+def _check_incremental(case: Case, grids, model, plan: Plan, transition: Optional[float]) -> None:
+    """What the incremental cycle does not do, refused or said."""
+    if grids.coarse is not None:
+        partial = transition is not None and case.loading.peak_stroke <= transition
+        raise CaseError(case.source, [("grid.coarse_element", "grid refinement (Eqs. 11-12) applies to the "
+                                                              "uniform-slip model at mid-stroke only; remove "
+                                                              "grid.coarse_element" + (
+                                                                  " (this stroke is in partial slip, where uniform "
+                                                                  "slip is refused)" if partial else
+                                                                  ", or use model.slip: uniform"))])
+    from fretsim.reference.mindlin import dundurs_beta
+    beta = dundurs_beta(case.moving.youngs_modulus, case.moving.poissons_ratio, case.stationary.youngs_modulus,
+                        case.stationary.poissons_ratio)
+    mu = case.loading.friction_coefficient or 0.0
+    if abs(beta) * mu > case.accuracy:
+        plan.warnings.append(f"dissimilar materials: Dundurs' β = {beta:.3f}, so the shear traction changes the "
+                             f"normal pressure by about βμ = {abs(beta) * mu:.1%} (first order), more than "
+                             f"model.accuracy {case.accuracy:.1%}; fretsim solves the normal and tangential "
+                             f"problems uncoupled and neglects it")
+    if model.corrections:
+        plan.warnings.append(f"the corrections {', '.join(model.corrections)} add normal compliance only: the "
+                             f"tangential compliance is the half-spaces'")
+
+
+def _warn_resolved(case: Case, plan: Plan) -> None:
+    plan.add(Choice("model.gap", case.gap_model, "not used: the stroke is resolved, each position sees the "
+                                                 "flat's wear under it", case.gap_model != "auto"))
+    plan.warnings.append("model.stroke resolved: the worn profiles develop kinks where the contact's edges "
+                         "turn at the stroke's ends, with pressure peaks there that grow as the grid is "
+                         "refined (the depths and widths settle; the peak pressure does not), and the "
+                         "depths move with the step size by a few per cent (README: the resolved stroke)")
+    if case.increments < 5:
+        plan.warnings.append(f"model.increments {case.increments} with the stroke resolved: the contact "
+                             f"is solved at only {case.increments} position(s) per half-stroke, so each "
+                             f"point's travel over the worn flat is sampled coarsely (the default 9 agrees "
+                             f"with 65 to 0.6 % in depth: README)")

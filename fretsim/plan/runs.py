@@ -1,0 +1,47 @@
+"""The runs a run makes besides its own — auto's proxies, a wear limit's pilot, the grid-error companions — and
+who hears of them.
+
+They can take a minute, so whoever owns the run (the CLI, a sweep worker, a notebook) may pass a
+:class:`SideRuns` that says what each is (``announce``) and shows its progress (``progress``: a context manager
+for a setup that yields a progress callback, as :func:`fretsim.simulate.simulate` takes one).  It also keeps the
+proxies and pilots already run, so that planning the same case again in its keeping (``check`` then ``run``, the
+corrections' proxies asked for again once the dimension is chosen, a sweep's points that share a pilot) does not
+run them twice.  A plan made without one prints nothing and keeps nothing.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+from typing import Any, Callable, Optional
+
+from fretsim.simulate import simulate
+
+CACHE_SIZE = 64  # proxies (or pilots) kept; beyond, the cache starts afresh
+
+
+@dataclass
+class SideRuns:
+    announce: Optional[Callable[[str], None]] = None
+    progress: Optional[Callable[[Any], Any]] = None
+    proxies: dict = field(default_factory=dict)  # repr(case dict) → the proxy run's summary
+    pilots: dict = field(default_factory=dict)  # repr(case dict) → the cycle a pilot reached a limit at (or None)
+
+    def say(self, what: str) -> None:
+        if self.announce is not None:
+            self.announce(what)
+
+    def run(self, what: str, setup):
+        """simulate(setup) for one of the runs a run makes besides its own, announced and with progress."""
+        self.say(what)
+        if self.progress is None:
+            return simulate(setup)
+        with self.progress(setup) as update:
+            return simulate(setup, progress=update)
+
+    def remembered(self, cache: dict, key: str, compute: Callable[[], Any]) -> Any:
+        """``cache[key]``, computed once."""
+        if key not in cache:
+            value = compute()
+            if len(cache) > CACHE_SIZE:
+                cache.clear()
+            cache[key] = value
+        return cache[key]

@@ -1,0 +1,220 @@
+"""``bdf2`` and ``implicit``: implicit steps of φ = h + ½r (variable-step BDF2, order 2, or backward Euler, order
+1; :mod:`fretsim.jumping`), one contact solve each with the compliance C + s·W, under error control.
+
+Depth: the local error estimate (BDF2: from the third divided difference; backward Euler: ½ΔN·Δr) of each
+body's deepest element (the reported depth), held to DEPTH_SHARE of the tolerance, else the step is redone
+smaller.  (Over the elements in contact throughout the step only: those the contact front crossed are not smooth
+in time, their estimate is meaningless, and their error is the pressure lag's, which landing handles.)
+Pressure: a step leaves a lag of about half the pressure change over it; near a recorded state the steps shrink
+until that lag is within the tolerance.  A solve that fails is retried with a quarter step.
+"""
+from __future__ import annotations
+
+import math
+from typing import Optional
+
+import numpy as np
+
+from fretsim.errors import NumericalFailure
+from fretsim.jumping import OMEGA_MAX, THETA_LANDING, bdf2_coefficients, bdf2_local_error, next_step
+from fretsim.loop.checks import model_growth_cause
+from fretsim.stepping.linear import relative_change
+
+MAX_RETRIES = 8  # a failed solve is retried with a smaller step this many times
+HISTORY_POINTS = 8  # states kept for BDF2 (partner, error estimate) and the predictor
+EXACT_CYCLES = 2  # implicit schemes start with this many of the model's own per-cycle steps
+PREDICTOR_POINTS = 2  # pressure states the warm start extrapolates from (2: linear, 3: quadratic)
+# The maximum depths are held to this share of jumping.tolerance (the pressure field to all of it): depths are
+# what designers extrapolate and compare with a wall, and an error made early in a short run is not damped
+# before it is reported (scripts/calibrate_stepping.py measures both against the exact model).
+DEPTH_SHARE = 0.07
+
+
+class Implicit:
+    implicit = True
+    per_cycle_short_runs = False
+
+    def __init__(self, name: str, order: int):
+        self.name, self.order = name, order
+
+    def reason(self, case) -> str:
+        if self.order == 2:
+            return (f"second-order implicit steps under error control (tolerance {case.step_tolerance:g}): no "
+                    f"stability limit, recorded states landed on with shrinking steps")
+        return "backward-Euler steps (first order) under error control"
+
+    def describe(self, case, summary: dict) -> str:
+        what = "BDF2" if self.order == 2 else "backward-Euler"
+        return f"{what} steps (tolerance {case.step_tolerance:g})"
+
+    def estimate_solves(self, setup) -> int:
+        # ~25 solves per decade of cycles after the first, ~7 per recorded state landed on (measured)
+        n = setup.cycles
+        return min(n + 1, int(10 + 12 * math.log10(max(n, 10)) + 7 * len(setup.snapshots)))
+
+    def max_jump(self, case, jump: int, limit: float, allow_unstable: bool) -> tuple[Optional[int], list]:
+        return case.max_jump, []
+
+    def growth_cause(self, setup, model) -> str:
+        return model_growth_cause(model, setup)
+
+    def run(self, loop):
+        s = loop.s
+        step = None
+        retries = 0
+        while loop.n < s.cycles:
+            loop.enter_block()
+            if loop.n < EXACT_CYCLES and s.stability_limit > 2.0:
+                step = _exact_cycle(loop) or step
+                continue
+            d, constrained = _step_size(loop, self.order)
+            partner = _partner(loop.history, d) if self.order == 2 else None
+            base, g = _base(loop.history, partner, d)
+            half = 0.5 if s.per_cycle else 0.0
+            try:
+                cyc = loop.cycle_at(loop.n + d, _predict(loop.history, loop.n + d), base[0], base[1],
+                                    implicit=g * d - half)
+            except NumericalFailure:
+                if d == 1 or retries >= MAX_RETRIES:
+                    raise
+                retries += 1
+                loop.rejected += 1
+                loop.jump = max(1.0, d / 4)
+                continue
+            accepted = _accept(loop, cyc, d, partner, base, g, half)
+            if accepted is None:
+                continue
+            retries = 0
+            error, k_order, e_p = accepted
+            proposal = next_step(d, error, s.step_tolerance, k_order)
+            loop.jump = max(loop.jump, proposal) if constrained else proposal
+            step = loop.emit(cyc, d, e_p) or step
+        return step
+
+
+def _partner(history: list, d: int) -> Optional[int]:
+    """BDF2's second point: the latest state at least d/OMEGA_MAX cycles back (None: a backward-Euler step)."""
+    n_now = history[-1][0]
+    for k in range(len(history) - 2, -1, -1):
+        if n_now - history[k][0] >= d / OMEGA_MAX:
+            return k
+    return None
+
+
+def _base(history: list, partner: Optional[int], d: int) -> tuple[tuple, float]:
+    """The step's known part of φ (moving, stationary, work) and γ: φ_{n+1} = base + γ·ΔN·r_{n+1}."""
+    _, phi_m, phi_s, _, phi_w = history[-1]
+    if partner is None:
+        return (phi_m, phi_s, phi_w), 1.0
+    n_k, k_m, k_s, _, k_w = history[partner]
+    b, g = bdf2_coefficients(d, history[-1][0] - n_k)
+    return (phi_m + b * (phi_m - k_m), phi_s + b * (phi_s - k_s), phi_w + b * (phi_w - k_w)), g
+
+
+def _accept(loop, cyc, d: int, partner: Optional[int], base: tuple, g: float, half: float) -> Optional[tuple]:
+    """Accept the step (advance the loop) or reject it (None, with the next step proposed): (the error relative
+    to the tolerance's depth share, the estimate's order, the pressure lag) of an accepted one."""
+    s = loop.s
+    tol = s.step_tolerance
+    p_now = loop.history[-1][3]
+    p_new, r_m, r_s = cyc.pressure, cyc.rate_moving, cyc.rate_stationary
+    new_phi_m, new_phi_s = base[0] + g * d * r_m, base[1] + g * d * r_s
+    new_phi_w = base[2] + g * d * cyc.work
+    h_m, h_s = new_phi_m - half * r_m, new_phi_s - half * r_s
+    err_m, err_s, k_order = _local_errors(loop, partner, d, p_now, p_new, r_m, r_s, new_phi_m, new_phi_s, h_m, h_s)
+    # a non-linear cycle: what its linearised implicit solve got wrong, counted in both bodies' errors; it
+    # limits the step only where the model's own solution is smooth (a resolved stroke's kinks are not)
+    smooth = not loop.model.singular_pressure
+    err_m, err_s = err_m + cyc.defect, err_s + cyc.defect
+    error = max(_rel_scalar(err_m if smooth else err_m - cyc.defect, _amax(h_m)),
+                _rel_scalar(err_s if smooth else err_s - cyc.defect, _amax(h_s))) / DEPTH_SHARE
+    if error > 1.5 * tol and d > 1:
+        loop.rejected += 1
+        loop.jump = next_step(d, error, tol, k_order)
+        return None
+    e_p = 0.5 * relative_change(p_new - p_now, p_new)
+    if loop.n + d == loop.next_stop() and e_p > tol and d > 1 and loop.n + d not in loop.boundaries:
+        # landing on a recorded state with a pressure lag beyond the tolerance: taper instead
+        loop.rejected += 1
+        loop.lag = max(loop.lag, e_p / d)
+        return None
+    loop.err_abs_m += err_m
+    loop.err_abs_s += err_s
+    loop.lag = e_p / d
+    loop.advance(h_m - loop.h_m, h_s - loop.h_s, d, new_phi_w - half * cyc.work - loop.work)
+    loop.history = (loop.history + [(loop.n, new_phi_m, new_phi_s, p_new, new_phi_w)])[-HISTORY_POINTS:]
+    return error, k_order, e_p
+
+
+def _local_errors(loop, partner, d, p_now, p_new, r_m, r_s, new_phi_m, new_phi_s, h_m, h_s) -> tuple:
+    """Each body's local depth error at its deepest element (absolute), over the elements in contact throughout
+    the step, and the order of the estimate."""
+    if partner is not None and partner > 0:
+        pts = (loop.history[partner - 1], loop.history[partner], loop.history[-1])
+        inner = (pts[0][3] > 0) & (pts[1][3] > 0) & (pts[2][3] > 0) & (p_new > 0)
+        times = tuple(float(q[0]) for q in pts) + (float(loop.n + d),)
+        e_m = bdf2_local_error(times, tuple(q[1][inner] for q in pts) + (new_phi_m[inner],))
+        e_s = bdf2_local_error(times, tuple(q[2][inner] for q in pts) + (new_phi_s[inner],))
+        k_order = 2
+    else:
+        inner = (p_now > 0) & (p_new > 0)
+        r0_m, r0_s = loop.r_m, loop.r_s  # the rates at the current state, history[-1]
+        e_m, e_s, k_order = 0.5 * d * (r_m - r0_m)[inner], 0.5 * d * (r_s - r0_s)[inner], 1
+    return _at_deepest(e_m, h_m[inner]), _at_deepest(e_s, h_s[inner]), k_order
+
+
+def _predict(history: list, cycle: int) -> np.ndarray:
+    """Warm start: the pressure history extrapolated to ``cycle`` (quadratic through the last three states,
+    linear through two), clipped at zero."""
+    pts = history[-PREDICTOR_POINTS:]
+    if len(pts) == 1:
+        return pts[0][3]
+    ns = [float(q[0]) for q in pts]
+    weights = [np.prod([(cycle - ns[j]) / (ns[i] - ns[j]) for j in range(len(ns)) if j != i])
+               for i in range(len(ns))]
+    return np.clip(sum(w * q[3] for w, q in zip(weights, pts)), 0.0, None)
+
+
+def _step_size(loop, order: int) -> tuple[int, bool]:
+    """The next step: the controller's, bounded by the stop, the caps and BDF2's step ratio, and tapered
+    towards the stop so the pressure recorded there carries no lag.  Returns (ΔN, constrained)."""
+    s = loop.s
+    rem = loop.next_stop() - loop.n
+    d = min(loop.jump, s.max_jump or np.inf, s.implicit_cap + 0.5)
+    if order == 2 and len(loop.history) > 1:
+        d = min(d, OMEGA_MAX * (loop.n - loop.history[0][0]))
+    # a step ending at (or near) a recorded state leaves a pressure lag ≈ lag·ΔN that the steps after it
+    # relax: within the landing zone cover at most THETA_LANDING of the rest, unless the rest is cheap
+    small = s.step_tolerance / loop.lag if loop.lag > 0 else np.inf
+    d_land = max(np.ceil(THETA_LANDING * rem), np.floor(small))
+    if loop.next_stop() in loop.boundaries:  # a block's end is not a recorded state: no pressure to land
+        d_land = rem
+    free = int(max(1, min(d, rem)))
+    d = int(max(1, min(d, rem, d_land)))
+    return d, d < free or d < loop.jump
+
+
+def _exact_cycle(loop):
+    """One cycle of the model itself (the per-cycle update, explicit and stable at one cycle).  The first
+    cycles change the pressure by ~0.5 % each, too fast for the modified equation the implicit schemes
+    integrate; taken one by one they are exact and cost what steps of one cycle would."""
+    cyc, e_p = loop.explicit_step(1)
+    r_m, r_s = cyc.rate_moving, cyc.rate_stationary
+    loop.jump, loop.lag = 2.0, e_p
+    loop.history = (loop.history + [(loop.n, loop.h_m + 0.5 * r_m, loop.h_s + 0.5 * r_s, cyc.pressure,
+                                     loop.work + 0.5 * cyc.work)])[-HISTORY_POINTS:]
+    return loop.emit(cyc, 1, e_p)
+
+
+def _rel_scalar(err: float, h) -> float:
+    n = float(np.linalg.norm(h)) if isinstance(h, np.ndarray) else float(h)
+    return err / n if n > 0 else 0.0
+
+
+def _amax(a: np.ndarray) -> float:
+    return float(np.abs(a).max()) if a.size else 0.0
+
+
+def _at_deepest(error: np.ndarray, depth: np.ndarray) -> float:
+    """|error| at the deepest element (0 when there is none)."""
+    return float(abs(error.ravel()[np.argmax(depth.ravel())])) if error.size else 0.0
