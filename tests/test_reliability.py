@@ -92,7 +92,7 @@ def tiny_disk(tmp_path):
 
 
 def test_a_full_disk_ends_the_run_with_exit_5_and_keeps_the_last_good_file(tiny_disk, monkeypatch):
-    import fretsim.results as results_module
+    import fretsim.results.writer as results_module
     out = tiny_disk / "out.h5"
     # a 2D run whose 100 snapshots outgrow 200 kB (a flush needs room for two copies): full in mid-run.  The
     # run is shorter than the flush interval, so flushing at every step stands in for a long run's flushes.
@@ -111,7 +111,7 @@ def test_a_full_disk_ends_the_run_with_exit_5_and_keeps_the_last_good_file(tiny_
 
 @pytest.mark.parametrize("failing_flush", [1, 2, 3, "final"])
 def test_an_injected_enospc_at_any_flush_leaves_a_valid_file_or_none(tmp_path, monkeypatch, failing_flush):
-    import fretsim.results as results_module
+    import fretsim.results.writer as results_module
     real_write = os.write
     flushes = {"n": 0}
     real_flush = results_module.ResultsWriter.flush

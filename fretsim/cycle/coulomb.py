@@ -162,91 +162,81 @@ class CoulombCycle:
         """One cycle.  With the pressure fixed (mid_stroke) a half-stroke is one monotone increment, which the
         tangential solve takes exactly whatever its length: unless ``detail`` asks for the loop's shape (a
         recorded state), each half-stroke is taken in one increment — the same wear, slips, energy and regime."""
-        g, dx = self.grid, self.grid.dx
-        mu = self.friction_coefficient
+        shape = self.grid.shape
         n = self.increments if detail or self.resolved else 1
-        area = g.area * self.volume_factor
         slip_lin = float((memory or {}).get("slip_lin", 4.0 * self.stroke))
         w_lin = scaled(self._w_unit, slip_lin / (4.0 * self.stroke)) if step else None
         extra = scaled(w_lin, step) if step else None
-        resolved = self.resolved
-        if not resolved:
-            seen = gap_wear(wear_moving, wear_stationary, dx, self.stroke, self.gap_model)
+        fixed = None
+        if not self.resolved:
+            seen = gap_wear(wear_moving, wear_stationary, self.grid.dx, self.stroke, self.gap_model)
             if correction is not None:
                 seen = seen + correction
-            p_fixed, res_fixed = normal(seen, guess, extra, load=self.load, cycle=cycle)
-        shape = g.shape
+            fixed = normal(seen, guess, extra, load=self.load, cycle=cycle)
+        tally = _Tally(shape, self.grid.area * self.volume_factor)
         q, s = np.zeros(shape), np.zeros(shape)
-        rate_m, rate_s = np.zeros(shape), np.zeros(shape)
-        slip_m, slip_s, p_seen, shear = np.zeros(shape), np.zeros(shape), np.zeros(shape), np.zeros(shape)
-        energy = work = 0.0
-        iterations = 0
-        loop_u, loop_q = [], []
         first = (n + 1) // 2  # the loop's first increment (after the loading quarter)
         mid, end = first + n // 2, first + n - 1  # centred on U = 0 going up; the up-stroke's end, U = +δ
         p_prev, ds_prev, du_prev = guess, None, None
         for k, (u0, u1, counted) in enumerate(self.path(n)):
             if k == first:
-                loop_u.append(u0)
-                loop_q.append(float(q.sum()) * area)
+                tally.loop(u0, q)
             du = u1 - u0
-            if resolved:
-                same_way = ds_prev is not None and du * du_prev > 0 and not self.rigid
-                ds_guess = ds_prev * (du / du_prev) if same_way else np.full(shape, du)
-                p, res = normal(wear_moving + sweep_read(wear_stationary, s, s + ds_guess, dx, self.kernel), p_prev, extra,
-                                load=self.load, cycle=cycle)
-                iterations += res.iterations
+            if self.resolved:
+                p, res, q_new, ds, stuck = self._resolved_increment(wear_moving, wear_stationary, normal, q, s, du,
+                                                                    p_prev, ds_prev, du_prev, extra, cycle, tally)
             else:
-                p, res, ds_guess = p_fixed, res_fixed, None
-            q_new, ds, stuck, its = self._tangential(q, p, du)
-            iterations += its
-            if resolved and not self.rigid:
-                off = np.abs(ds - ds_guess)[p > 0]
-                if off.size and off.max() > TRAVEL_TOLERANCE * dx:  # solve again where the points really went
-                    ds_guess = ds
-                    p, res = normal(wear_moving + sweep_read(wear_stationary, s, s + ds, dx, self.kernel), p, extra,
-                                    load=self.load, cycle=cycle)
-                    q_new, ds, stuck, its = self._tangential(q, p, du)
-                    iterations += res.iterations + its
+                (p, res), (q_new, ds, stuck, its) = fixed, self._tangential(q, fixed[0], du)
+                tally.iterations += its
             if counted:
-                amount = self.law.amount(p, q_new, ds)
-                rate_m += self.k_moving * amount
-                rate_s += self.k_stationary * sweep_deposit(amount, s, s + ds, dx, self.kernel)
-                slip_m += np.abs(ds)
-                slip_s += sweep_deposit(np.abs(ds), s, s + ds, dx, self.kernel)
-                p_seen += sweep_deposit(p, s, s + ds, dx, self.kernel)
-                energy += float((np.abs(q_new) * np.abs(ds)).sum()) * area
-                work += float(amount.sum()) * area
-                shear = np.maximum(shear, np.abs(q_new))
-                loop_u.append(u1)
-                loop_q.append(float(q_new.sum()) * area)
+                tally.add(self, p, q_new, s, ds)
+                tally.loop(u1, q_new)
             if k == mid:
                 p_mid, res_mid, travel_mid = p, res, (s, s + ds)
             if k == end:
                 stick_end = stuck & (p > 0)
             s, q = s + ds, q_new
             p_prev, ds_prev, du_prev = p, ds, du
-        p_seen /= 2 * n
+        tally.p_seen /= 2 * n
         defect, mismatch = 0.0, None
         if step:
-            # the gap growth the mid-stroke solve anticipated against what the cycle found for that position
-            found = rate_m + (sweep_read(rate_s, *travel_mid, dx, self.kernel) if resolved else
-                              gap_wear(np.zeros(shape), rate_s, dx, self.stroke, self.gap_model))
-            deepest = np.unravel_index(np.argmax(wear_moving + wear_stationary), shape)
-            mismatch = step * (found - w_lin(p_mid))
-            defect = abs(float(self._response(step, w_lin, mismatch - (correction if correction is not None else 0))[deepest]))
-        on = p_mid > 0
-        s_mean = float((p_mid * slip_m).sum() / p_mid.sum())
-        s_max = float(slip_m[on].max()) if on.any() else 0.0
-        return Cycle(
-            pressure=p_mid, pressure_stationary=p_seen, rate_moving=rate_m, rate_stationary=rate_s,
-            slip_moving=slip_m, slip_stationary=slip_s, shear=shear, energy=energy, work=work,
-            force_amplitude=float(np.abs(loop_q).max()),
-            regime="partial_slip" if stick_end.any() else "gross_slip",
-            stick_half_width_x=stick_half_width(stick_end[shape[0] // 2], g.x, dx), contact=res_mid,
-            iterations=iterations, loop=(np.array(loop_u), np.array(loop_q)),
-            memory={"slip_lin": max(s_max, 1e-300), "slip_spread": 1.0 - s_mean / s_max if s_max > 0 else 1.0}, defect=defect, mismatch=mismatch,
-            stick=stick_end if stick_end.any() else None)
+            defect, mismatch = self._defect(wear_moving, wear_stationary, step, w_lin, tally, p_mid, travel_mid,
+                                            correction)
+        return tally.cycle(self, p_mid, res_mid, stick_end, defect, mismatch)
+
+    def _resolved_increment(self, wear_moving, wear_stationary, normal, q, s, du, p_prev, ds_prev, du_prev, extra,
+                            cycle: int, tally: "_Tally"):
+        """One increment with the normal contact solved where the moving body is: each of its points over the worn
+        flat at the travel predicted from the last increment, solved again where a point went elsewhere."""
+        dx = self.grid.dx
+        same_way = ds_prev is not None and du * du_prev > 0 and not self.rigid
+        ds_guess = ds_prev * (du / du_prev) if same_way else np.full(self.grid.shape, du)
+        p, res = normal(wear_moving + sweep_read(wear_stationary, s, s + ds_guess, dx, self.kernel), p_prev, extra,
+                        load=self.load, cycle=cycle)
+        tally.iterations += res.iterations
+        q_new, ds, stuck, its = self._tangential(q, p, du)
+        tally.iterations += its
+        if not self.rigid:
+            off = np.abs(ds - ds_guess)[p > 0]
+            if off.size and off.max() > TRAVEL_TOLERANCE * dx:  # solve again where the points really went
+                p, res = normal(wear_moving + sweep_read(wear_stationary, s, s + ds, dx, self.kernel), p, extra,
+                                load=self.load, cycle=cycle)
+                q_new, ds, stuck, its = self._tangential(q, p, du)
+                tally.iterations += res.iterations + its
+        return p, res, q_new, ds, stuck
+
+    def _defect(self, wear_moving, wear_stationary, step: float, w_lin, tally: "_Tally", p_mid, travel_mid,
+                correction) -> tuple[float, np.ndarray]:
+        """An implicit step's linearisation error: the gap growth the mid-stroke solve anticipated against what the
+        cycle found for that position (``mismatch``), and its effect on the deepest element's wear (``defect``)."""
+        dx, shape = self.grid.dx, self.grid.shape
+        found = tally.rate_m + (sweep_read(tally.rate_s, *travel_mid, dx, self.kernel) if self.resolved else
+                                gap_wear(np.zeros(shape), tally.rate_s, dx, self.stroke, self.gap_model))
+        deepest = np.unravel_index(np.argmax(wear_moving + wear_stationary), shape)
+        mismatch = step * (found - w_lin(p_mid))
+        defect = abs(float(self._response(step, w_lin, mismatch - (correction if correction is not None else 0))
+                           [deepest]))
+        return defect, mismatch
 
     def _tangential(self, q, p, du):
         """One increment's traction, slip and stick set; rigid bodies (``slip: uniform``) slide with the rig."""
@@ -272,6 +262,54 @@ class CoulombCycle:
         c_hat = conv.hat if conv is not None else self.compliance.hat
         w_hat = step * w_lin.hat
         return w_lin.backward(w_lin.forward(mismatch) * (w_hat / (c_hat + w_hat)))
+
+
+class _Tally:
+    """What a cycle's increments add up to: each body's wear and slip, the flat's pressure over the travel, the
+    shear's amplitude, the energy, the invariant's work and the loop, and the solvers' iterations."""
+
+    def __init__(self, shape: tuple, area: float):
+        self.area = area
+        self.rate_m, self.rate_s = np.zeros(shape), np.zeros(shape)
+        self.slip_m, self.slip_s, self.p_seen, self.shear = (np.zeros(shape), np.zeros(shape), np.zeros(shape),
+                                                             np.zeros(shape))
+        self.energy = self.work = 0.0
+        self.iterations = 0
+        self.loop_u, self.loop_q = [], []
+
+    def loop(self, u: float, q: np.ndarray) -> None:
+        """A point of the fretting loop: the rig's displacement and the total tangential force."""
+        self.loop_u.append(u)
+        self.loop_q.append(float(q.sum()) * self.area)
+
+    def add(self, member: "CoulombCycle", p, q_new, s, ds) -> None:
+        """One counted increment: the moving body wears at its own points, the flat where each point travelled."""
+        dx, kernel = member.grid.dx, member.kernel
+        amount = member.law.amount(p, q_new, ds)
+        self.rate_m += member.k_moving * amount
+        self.rate_s += member.k_stationary * sweep_deposit(amount, s, s + ds, dx, kernel)
+        self.slip_m += np.abs(ds)
+        self.slip_s += sweep_deposit(np.abs(ds), s, s + ds, dx, kernel)
+        self.p_seen += sweep_deposit(p, s, s + ds, dx, kernel)
+        self.energy += float((np.abs(q_new) * np.abs(ds)).sum()) * self.area
+        self.work += float(amount.sum()) * self.area
+        self.shear = np.maximum(self.shear, np.abs(q_new))
+
+    def cycle(self, member: "CoulombCycle", p_mid, res_mid, stick_end, defect: float, mismatch) -> Cycle:
+        """The cycle these increments make, with the memory its next cycle's implicit step needs."""
+        g = member.grid
+        on = p_mid > 0
+        s_mean = float((p_mid * self.slip_m).sum() / p_mid.sum())
+        s_max = float(self.slip_m[on].max()) if on.any() else 0.0
+        return Cycle(
+            pressure=p_mid, pressure_stationary=self.p_seen, rate_moving=self.rate_m, rate_stationary=self.rate_s,
+            slip_moving=self.slip_m, slip_stationary=self.slip_s, shear=self.shear, energy=self.energy,
+            work=self.work, force_amplitude=float(np.abs(self.loop_q).max()),
+            regime="partial_slip" if stick_end.any() else "gross_slip",
+            stick_half_width_x=stick_half_width(stick_end[g.shape[0] // 2], g.x, g.dx), contact=res_mid,
+            iterations=self.iterations, loop=(np.array(self.loop_u), np.array(self.loop_q)),
+            memory={"slip_lin": max(s_max, 1e-300), "slip_spread": 1.0 - s_mean / s_max if s_max > 0 else 1.0},
+            defect=defect, mismatch=mismatch, stick=stick_end if stick_end.any() else None)
 
 
 def _span(mask: np.ndarray) -> slice:

@@ -1,0 +1,71 @@
+"""The results file's layout: its format versions, and what each step and snapshot writes, with units."""
+from __future__ import annotations
+
+from fretsim.quantities import SUMMARY, WEAR
+
+FORMAT_VERSION = "1.4"
+READABLE_FORMATS = ("1.1", "1.2", "1.3", "1.4")
+FLUSH_SECONDS = 0.5
+FLUSH_COST_FACTOR = 20.0  # flushes no more often than this many times their own cost (≤ ~5 % of the run)
+STATUSES = ("running", "complete", "interrupted", "failed", "stopped")
+MAX_DATASET_BYTES = 2**32  # 4 GiB: no results file of this tool holds a larger array
+MAX_NAME = 200  # bytes of the output's base name we accept (temporaries use fixed-length names)
+
+# name: (units, long name, how to get the value from a Step)
+HISTORY = {
+    "cycle": ("cycles", "cycle number", lambda s: s.cycle),
+    **{key: (WEAR[key].unit, WEAR[key].long_name, lambda s, q=WEAR[key]: q.measure(s, None, None) * q.factor)
+       for key in ("max_wear_depth_moving", "max_wear_depth_stationary")},
+    "max_wear_depth_total": ("um", "maximum total wear depth", lambda s: (s.wear_moving + s.wear_stationary).max() * 1e3),
+    **{key: ("mm^3", WEAR[key].long_name, lambda s, q=WEAR[key]: q.measure(s, None, None))
+       for key in ("wear_volume_moving", "wear_volume_stationary")},
+    "max_pressure": ("MPa", "maximum contact pressure", lambda s: s.pressure.max()),
+    "solver_iterations": ("1", "contact solver iterations", lambda s: s.iterations),
+    "wall_time": ("s", "wall time since the start of the run", lambda s: s.wall_time),
+    "approach": ("um", "rigid-body approach", lambda s: s.approach * 1e3),
+    "archard_volume_error": ("1", "relative difference of the wear volume from k·P·4δ·N", lambda s: s.archard_error),
+    "checkerboard_amplitude": ("1", "odd-even pressure amplitude relative to the mean", lambda s: abs(s.checkerboard)),
+    "cycle_jump": ("cycles", "cycles since the previous step", lambda s: s.jump),
+    "rejected_steps": ("1", "steps rejected since the previous accepted one", lambda s: s.rejected),
+    "error_estimate_depth": ("1", "the stepping's part of the relative error of the maximum depths (the run's "
+                                  "estimate against the exact per-cycle model on its grid)", lambda s: s.error_depth),
+    "error_estimate_pressure": ("1", "the stepping's part of the relative error of the pressure field (L2)",
+                                lambda s: s.error_pressure),
+    "dissipated_energy_J": ("J", "energy dissipated per cycle by friction at this state (NaN: no friction "
+                                 "coefficient)", lambda s: s.cycle_result.energy * 1e-3),
+    "wear_work": ("N*mm", "the wear invariant's work accumulated: Σp·|ds|·A (Archard) or Σ|q|·|ds|·A (energy "
+                          "law) over the cycles; each body's wear volume is its coefficient times it",
+                  lambda s: s.work),
+    "block": ("1", "the loading's block (from 0, in the order applied) whose cycles led to this state",
+              lambda s: s.block),
+}
+INTEGER_HISTORY = {"cycle", "solver_iterations", "cycle_jump", "rejected_steps", "block"}
+HISTORY_V11 = [k for k in HISTORY if not k.startswith("error_estimate") and k not in ("dissipated_energy_J",
+                                                                                        "wear_work", "block")]
+HISTORY_V12 = [k for k in HISTORY if k not in ("dissipated_energy_J", "wear_work", "block")]
+HISTORY_V13 = [k for k in HISTORY if k != "block"]
+FIELDS = {
+    "wear_depth_moving": ("um", "wear depth of the moving body", lambda s: s.wear_moving * 1e3),
+    "wear_depth_stationary": ("um", "wear depth of the stationary body", lambda s: s.wear_stationary * 1e3),
+    "pressure": ("MPa", "contact pressure on the moving body at mid-stroke", lambda s: s.pressure),
+    "pressure_stationary_average": ("MPa", "stroke-averaged pressure on the stationary body",
+                                    lambda s: s.pressure_average),
+    "slip_distance_moving": ("um", "slip distance per cycle at each point of the moving body",
+                             lambda s: s.cycle_result.slip_moving * 1e3),
+    "slip_distance_stationary": ("um", "slip distance per cycle at each point of the stationary body",
+                                 lambda s: s.cycle_result.slip_stationary * 1e3),
+    "shear_traction": ("MPa", "amplitude of the shear traction on the moving body over the cycle (NaN: not "
+                              "modelled)", lambda s: s.cycle_result.shear),
+}
+FIELDS_V12 = [k for k in FIELDS if not k.startswith(("slip_distance", "shear"))]
+NAN_FIELDS = {"shear_traction"}  # the uniform model without a friction coefficient does not know it
+SUMMARY_UNITS = {key: figure.unit for key, figure in SUMMARY.items()}
+NAN_SUMMARY = {key for key, figure in SUMMARY.items() if figure.nan}
+
+
+
+
+def summary_long_name(key: str) -> str:
+    return key.replace("_", " ")
+
+

@@ -1,0 +1,342 @@
+"""Reading a results file back: structure, types, shapes against the grid, sizes before allocating, finiteness
+and the checksums verified, and a damaged file refused with the path of what is wrong."""
+from __future__ import annotations
+
+import hashlib
+import json
+import math
+import os
+import stat
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Optional
+
+import h5py
+import numpy as np
+
+from fretsim.errors import ResultsFileError
+from fretsim.results.layout import (FIELDS, FIELDS_V12, FORMAT_VERSION, HISTORY, HISTORY_V11, HISTORY_V12, HISTORY_V13,
+                                    MAX_DATASET_BYTES, NAN_FIELDS, NAN_SUMMARY, READABLE_FORMATS, STATUSES)
+from fretsim.results.seal import SEALED_FROM, _SCALE_ATTRS, _Damaged, _verify_seal, checkpoint_digest, plain, text
+
+
+@dataclass
+class Results:
+    """A results file read back into memory (arrays in the file's units; see ``units``)."""
+
+    path: str
+    attrs: dict
+    case_yaml: str
+    x: np.ndarray
+    y: np.ndarray
+    history: dict
+    fields: dict
+    summary: dict
+    units: dict
+    checkpoint: Optional[dict] = None
+    fretting_loop: dict = field(default_factory=dict)  # cycle, displacement (um), tangential_force (N)
+    choices: list = field(default_factory=list)  # (key, value, reason) of every automatic choice
+    inputs: dict = field(default_factory=dict)  # name: (value, units)
+    overrides: list = field(default_factory=list)
+
+    @property
+    def status(self) -> str:
+        return self.attrs.get("status", "")
+
+    def _case_section(self, name: str) -> dict:
+        """A top-level mapping of the stored case ({} where absent or not a mapping)."""
+        from fretsim.yamlread import YamlProblem, loads
+        try:
+            section = (loads(self.case_yaml) or {}).get(name) or {}
+        except (YamlProblem, AttributeError):
+            return {}
+        return section if isinstance(section, dict) else {}
+
+    def depth_limits(self) -> dict:
+        """The case's wear limits on depths (key → (µm, as written)): what the history figure draws."""
+        from fretsim.units import UnitError, parse_quantity
+        out = {}
+        for key, written in self._case_section("limits").items():
+            if "wear_depth" in str(key):
+                try:
+                    out[key] = (parse_quantity(written, "length") * 1e3, str(written))
+                except UnitError:
+                    continue
+        return out
+
+    def published(self) -> dict:
+        """source (experiment, fea, paper) → (the flat's centre-line depth µm, its scar width mm) from the case's
+        `expected:` data (None where absent): what figures compare with."""
+        from fretsim.units import UnitError, parse_quantity
+        out = {}
+        for source, values in self._case_section("expected").items():
+            if not isinstance(values, dict):
+                continue
+            got = []
+            for key in ("centre_wear_depth_stationary", "scar_width_stationary"):
+                try:
+                    got.append(parse_quantity(values[key], "length") if key in values else None)
+                except UnitError:
+                    got.append(None)
+            if any(v is not None for v in got):
+                out[source] = (got[0] * 1e3 if got[0] is not None else None, got[1])
+        return out
+
+    def to_xarray(self):
+        """The run as one xarray Dataset: the fields over (cycle, y, x) at the recorded states, the history over
+        ``step`` (every accepted step, with its cycle as the coordinate ``step_cycle``), units on every variable,
+        and the summary as attributes.  Needs xarray (``pip install xarray``)."""
+        import xarray as xr
+        coords = {"cycle": ("cycle", self.fields["cycle"], {"units": "cycles", "long_name": "recorded state"}),
+                  "y": ("y", self.y, {"units": "mm"}), "x": ("x", self.x, {"units": "mm"}),
+                  "step": ("step", np.arange(len(self.history["cycle"])), {"long_name": "accepted step"}),
+                  "step_cycle": ("step", self.history["cycle"], {"units": "cycles",
+                                                                 "long_name": "cycle of the accepted step"})}
+        data = {k: (("cycle", "y", "x"), v, {"units": self.units.get(f"fields/{k}", "")})
+                for k, v in self.fields.items() if k != "cycle"}
+        data.update({k: ("step", v, {"units": self.units.get(f"history/{k}", "")})
+                     for k, v in self.history.items() if k not in ("cycle", "step")})
+        attrs = {"case_name": self.attrs.get("case_name", ""), "status": self.status}
+        attrs.update({k: v for k, v in self.summary.items() if isinstance(v, (int, float, str))})
+        return xr.Dataset(data, coords=coords, attrs=attrs)
+
+
+def _name(key, where: str) -> str:
+    """A dataset or attribute name as written by this tool: a plain identifier (a damaged name is refused)."""
+    if not isinstance(key, str) or not key.replace("_", "a").isalnum() or not key.isascii():
+        raise _Damaged(f"{where}: an entry has a damaged name {str(key)[:40]!r}")
+    return key
+
+
+def _regular_file(path: str | Path) -> None:
+    try:
+        st = os.stat(path)
+    except FileNotFoundError:
+        raise ResultsFileError(f"{path}: no such results file") from None
+    except OSError as exc:
+        raise ResultsFileError(f"{path}: cannot read it ({exc.strerror})") from None
+    if stat.S_ISDIR(st.st_mode):
+        raise ResultsFileError(f"{path}: is a directory, not a results file")
+    if not stat.S_ISREG(st.st_mode):
+        raise ResultsFileError(f"{path}: not a regular file (a FIFO, device or socket); expected an HDF5 results file")
+
+
+def _dataset(f, path: str, ndim: Optional[int] = None, numeric: bool = True, shape: Optional[tuple] = None,
+             allow_nan: bool = False):
+    obj = f.get(path)
+    if obj is None:
+        raise _Damaged(f"/{path}: missing")
+    if not isinstance(obj, h5py.Dataset):
+        raise _Damaged(f"/{path}: expected a dataset, found a {type(obj).__name__.lower()}")
+    if ndim is not None and obj.ndim != ndim:
+        raise _Damaged(f"/{path}: expected {ndim} dimension(s), found shape {obj.shape}")
+    if shape is not None and obj.shape != shape:
+        raise _Damaged(f"/{path}: expected shape {shape}, found {obj.shape}")
+    if numeric and obj.dtype.kind not in "iuf":
+        raise _Damaged(f"/{path}: expected numbers, found data of type {obj.dtype}")
+    if obj.size * max(obj.dtype.itemsize, 1) > MAX_DATASET_BYTES:
+        raise _Damaged(f"/{path}: declares {obj.size:.3g} values ({obj.size * obj.dtype.itemsize / 2**30:.1f} GiB), "
+                       f"more than any results file holds")
+    data = obj[()]
+    if numeric and data.dtype.kind == "f" and not (np.isfinite(data) | (allow_nan & np.isnan(data))).all():
+        raise _Damaged(f"/{path}: holds non-finite values (NaN or infinity)")
+    return data
+
+
+def _group(f, path: str):
+    obj = f.get(path)
+    if obj is None:
+        raise _Damaged(f"/{path}: missing")
+    if not isinstance(obj, h5py.Group):
+        raise _Damaged(f"/{path}: expected a group, found a {type(obj).__name__.lower()}")
+    return obj
+
+
+def read_results(path: str | Path, for_resume: bool = False) -> Results:
+    """Read a results file, verifying it; raises ``ValueError`` naming the file and what is wrong.
+
+    ``for_resume`` also requires a complete, intact checkpoint that fits the grid.
+    """
+    _regular_file(path)
+    try:
+        with h5py.File(path, "r") as f:
+            return _read(f, str(path), for_resume)
+    except _Damaged as exc:
+        raise ResultsFileError(f"{path}: damaged or not a fretsim results file: {exc}") from None
+    except (OSError, RuntimeError, KeyError, TypeError, IndexError, AttributeError, UnicodeDecodeError) as exc:
+        raise ResultsFileError(f"{path}: not a readable fretsim results file ({type(exc).__name__}: "
+                         f"{str(exc)[:200]})") from None
+
+
+def _read(f, path: str, for_resume: bool) -> Results:
+    version, attrs, case_yaml = _read_head(f, path)
+    x = _dataset(f, "grid/x", 1)
+    y = _dataset(f, "grid/y", 1)
+    if not (x.size and y.size) or (x.size > 1 and not (np.diff(x) > 0).all()) or (y.size > 1 and not (np.diff(y) > 0).all()):
+        raise _Damaged("/grid: x and y must be increasing element centres")
+    ny, nx = y.size, x.size
+    units: dict = {}
+    history = _read_history(f, version, units)
+    fields = _read_fields(f, version, (ny, nx), units)
+    loop = _read_loop(f, version, fields["cycle"], units)
+    summary = _read_summary(f)
+    checkpoint = _read_checkpoint(f, (ny, nx)) if "checkpoint" in f else None
+    if for_resume and version != FORMAT_VERSION:
+        raise _Damaged(f"written in format {version}; this fretsim resumes format {FORMAT_VERSION} only (its steps "
+                       f"would lack what this version records): run the case again, or resume it with the version "
+                       f"that wrote it ({attrs.get('fretsim_version', '?')})")
+    if for_resume and checkpoint is None:
+        raise _Damaged("/checkpoint: missing; the run cannot be resumed (it was written before its first step)")
+    choices = []
+    if "choices" in f:
+        _group(f, "choices")
+        cols = [[text(v) for v in _dataset(f, f"choices/{k}", 1, numeric=False)] for k in ("key", "value", "reason")]
+        choices = list(zip(*cols))
+    inputs, overrides = _read_inputs(f)
+    return Results(path=path, attrs=attrs, case_yaml=case_yaml, x=x, y=y, history=history, fields=fields,
+                   summary=summary, units=units, checkpoint=checkpoint, fretting_loop=loop, choices=choices,
+                   inputs=inputs, overrides=overrides)
+
+
+def _read_head(f, path: str) -> tuple[str, dict, str]:
+    """The format version (its checksums verified), the root's attributes and the case's text."""
+    if "format_version" not in f.attrs:
+        raise ResultsFileError(f"{path} is an HDF5 file but not a fretsim results file (no format_version)")
+    version = text(f.attrs["format_version"])
+    if version not in READABLE_FORMATS:
+        raise _Damaged(f"format_version {version!r} is not one this fretsim reads ({', '.join(READABLE_FORMATS)})")
+    if version >= SEALED_FROM:
+        _verify_seal(f)
+    attrs = {k: plain(v) for k, v in f.attrs.items() if k not in _SCALE_ATTRS}
+    if attrs.get("status") not in STATUSES:
+        raise _Damaged(f"the status {str(attrs.get('status'))[:40]!r} is not one of {', '.join(STATUSES)}")
+    case_ds = f.get("case")
+    if not isinstance(case_ds, h5py.Dataset) or case_ds.dtype.kind not in "OS" or case_ds.shape != ():
+        raise _Damaged("/case: missing or not a text")
+    case_yaml = text(case_ds[()])
+    if "sha256" in case_ds.attrs and hashlib.sha256(case_yaml.encode()).hexdigest() != text(case_ds.attrs["sha256"]):
+        raise _Damaged("/case: its text does not match its checksum")
+    return version, attrs, case_yaml
+
+
+def _read_history(f, version: str, units: dict) -> dict:
+    hist_group = _group(f, "history")
+    expected = (HISTORY if version >= "1.4" else HISTORY_V13 if version == "1.3" else HISTORY_V12 if version == "1.2"
+                else HISTORY_V11)
+    history = {}
+    for k in expected:
+        history[k] = _dataset(f, f"history/{k}", 1, allow_nan=k == "dissipated_energy_J")
+        units[f"history/{k}"] = text(hist_group[k].attrs.get("units", ""))
+    lengths = {v.shape[0] for v in history.values()}
+    if len(lengths) > 1:
+        raise _Damaged(f"/history: its entries have different lengths {sorted(lengths)}")
+    return history
+
+
+def _read_fields(f, version: str, shape: tuple, units: dict) -> dict:
+    fl = _group(f, "fields")
+    cycles = _dataset(f, "fields/cycle", 1)
+    units["fields/cycle"] = "cycles"
+    fields = {"cycle": cycles}
+    for k in (FIELDS if version >= "1.3" else FIELDS_V12):
+        fields[k] = _dataset(f, f"fields/{k}", 3, shape=(cycles.size,) + shape, allow_nan=k in NAN_FIELDS)
+        units[f"fields/{k}"] = text(fl[k].attrs.get("units", ""))
+    return fields
+
+
+def _read_loop(f, version: str, cycles: np.ndarray, units: dict) -> dict:
+    loop = {"cycle": cycles, "displacement": np.zeros((cycles.size, 0)), "tangential_force": np.zeros((cycles.size, 0))}
+    if version >= "1.3":
+        loop["cycle"] = _dataset(f, "fretting_loop/cycle", 1, shape=(cycles.size,))
+        if not np.array_equal(loop["cycle"], cycles):
+            raise _Damaged("/fretting_loop/cycle: not the snapshot cycles of /fields")
+        for k in ("displacement", "tangential_force"):
+            loop[k] = _dataset(f, f"fretting_loop/{k}", 2, allow_nan=True)
+            if loop[k].shape[0] != cycles.size or loop[k].shape != loop["displacement"].shape:
+                raise _Damaged(f"/fretting_loop/{k}: shape {loop[k].shape} does not fit the snapshots")
+            units[f"fretting_loop/{k}"] = text(f[f"fretting_loop/{k}"].attrs.get("units", ""))
+    return loop
+
+
+def _read_summary(f) -> dict:
+    summary = {}
+    for k, v in _group(f, "summary").attrs.items():
+        k = _name(k, "/summary")
+        if k == "units" or k in _SCALE_ATTRS:
+            continue
+        v = plain(v)
+        if isinstance(v, (list, tuple, np.ndarray)) or not isinstance(v, (int, float, str, type(None))):
+            raise _Damaged(f"/summary: {k} is not a single value")
+        if isinstance(v, float) and not math.isfinite(v) and k not in NAN_SUMMARY:
+            raise _Damaged(f"/summary: {k} is not finite")
+        summary[k] = v
+    return summary
+
+
+def _read_inputs(f) -> tuple[dict, list]:
+    inputs, overrides = {}, []
+    if "inputs" in f:
+        g = _group(f, "inputs")
+        for k, ds in g.items():
+            k = _name(k, "/inputs")
+            if isinstance(ds, h5py.Dataset) and ds.shape == ():
+                value = ds[()]
+                inputs[k] = (text(value) if isinstance(value, bytes) else plain(value), text(ds.attrs.get("units", "")))
+        try:
+            overrides = [str(o) for o in json.loads(text(g.attrs.get("overrides", "[]")))]
+        except (ValueError, TypeError):
+            raise _Damaged("/inputs: its overrides attribute is not a JSON list") from None
+    return inputs, overrides
+
+
+def _read_checkpoint(f, shape: tuple) -> dict:
+    c = _group(f, "checkpoint")
+    state: dict = {}
+    for k, ds in c.items():
+        k = _name(k, "/checkpoint")
+        if not isinstance(ds, h5py.Dataset):
+            raise _Damaged(f"/checkpoint/{k}: expected a dataset")
+        data = _dataset(f, f"checkpoint/{k}")
+        if k in ("h_m", "h_s", "p", "p_prev") and data.shape != shape:
+            raise _Damaged(f"/checkpoint/{k}: shape {data.shape} does not fit the grid {shape}")
+        if k in ("history", "batch") and (data.ndim != 3 or data.shape[1:] != shape):
+            raise _Damaged(f"/checkpoint/{k}: shape {data.shape} does not fit the grid {shape}")
+        state[k] = data
+    digest = None
+    for k, v in c.attrs.items():
+        k = _name(k, "/checkpoint")
+        if k == "sha256":
+            digest = text(v)
+        elif k.endswith("_empty"):
+            state[k[:-6]] = []
+        else:
+            v = plain(v)
+            if isinstance(v, float) and not math.isfinite(v):
+                raise _Damaged(f"/checkpoint: {k} is not finite")
+            state[k] = v
+    for k in ("history", "batch"):
+        if isinstance(state.get(k), np.ndarray):
+            state[k] = list(state[k])
+    if digest is not None:
+        if checkpoint_digest(state) != digest:
+            raise _Damaged("/checkpoint: its contents do not match its checksum")
+    for key in ("n", "h_m", "h_s", "p"):
+        if key not in state:
+            raise _Damaged(f"/checkpoint/{key}: missing")
+    return state
+
+
+def summary_json(res: Results) -> dict:
+    """The summary, the inputs and the overrides as strict JSON-able values (NaN and infinity as null)."""
+    def clean(v):
+        if isinstance(v, float) and not math.isfinite(v):
+            return None
+        return v
+    data = {"status": res.status, "case_name": res.attrs.get("case_name"), "path": res.path}
+    data.update({k: clean(v) for k, v in res.summary.items()})
+    data["inputs"] = {k: clean(v[0]) for k, v in res.inputs.items()}
+    data["input_units"] = {k: v[1] for k, v in res.inputs.items()}
+    data["overrides"] = list(res.overrides)
+    return data
+
+

@@ -1,0 +1,250 @@
+"""The results file's writer: an observer of the loop that keeps the run in memory and the file complete on disk.
+
+At every flush it builds the whole file as an in-memory HDF5 image, writes it with plain file I/O to a temporary
+file beside the target, fsyncs it and renames it over the target (atomic on POSIX), so a full disk or an I/O
+error is an ordinary OSError at a known point and the last good file stays intact.
+"""
+from __future__ import annotations
+
+import errno
+import io
+import json
+import math
+import os
+import time
+from pathlib import Path
+from typing import Optional
+
+import h5py
+import numpy as np
+
+from fretsim import __version__
+from fretsim.results.layout import FIELDS, FORMAT_VERSION, HISTORY, INTEGER_HISTORY, SUMMARY_UNITS, summary_long_name
+from fretsim.results.seal import _SealingWriter, checkpoint_digest
+from fretsim.results.reader import Results
+
+FLUSH_SECONDS = 0.5
+FLUSH_COST_FACTOR = 20.0  # flushes no more often than this many times their own cost (≤ ~5 % of the run)
+
+
+class ResultsIOError(OSError):
+    """Writing the results failed (disk full, I/O error, directory gone); the last good file is intact."""
+
+
+
+class ResultsWriter:
+    """Observer that records each accepted step and keeps the results file complete on disk.
+
+    ``previous`` (a :class:`Results` read back from an interrupted run) seeds the history and fields, so a
+    resumed run appends to what was there.  ``replace`` allows replacing an existing file (overwrite, resume).
+    """
+
+    def __init__(self, path: str | Path, case_yaml: str, case_name: str, grid, notes=(), overwrite: bool = False,
+                 previous: Optional["Results"] = None, choices=(), inputs: Optional[dict] = None,
+                 input_sha256: str = ""):
+        self.path = Path(path)
+        self.replace = overwrite or previous is not None
+        if self.path.exists() and not self.replace:
+            raise FileExistsError(f"{self.path} exists")
+        self.case_yaml, self.case_name, self.grid, self.notes = case_yaml, case_name, grid, tuple(notes)
+        # what the case asked for before the plan filled it (Case.fingerprint); a resumed run keeps its original
+        self.input_sha256 = str(previous.attrs.get("input_sha256", "")) if previous is not None else input_sha256
+        self.choices = tuple(choices)
+        self.inputs = inputs or {}
+        if previous is not None:
+            self.rows = [list(r) for r in zip(*(previous.history.get(k, np.zeros(len(previous.history["cycle"])))
+                                                for k in HISTORY))] if len(previous.history.get("cycle", [])) else []
+            self.fields = {k: list(previous.fields[k]) for k in FIELDS}
+            self.field_cycles = list(previous.fields["cycle"])
+            self.loops = [tuple(pair) for pair in zip(previous.fretting_loop["displacement"],
+                                                      previous.fretting_loop["tangential_force"])]
+        else:
+            self.rows, self.fields, self.field_cycles = [], {k: [] for k in FIELDS}, []
+            self.loops = []  # (applied displacement um, tangential force N) at each snapshot
+        self.status, self.message, self.summary = "running", "", {}
+        self.state: Optional[dict] = None
+        self._flushed = -math.inf
+        self._started: Optional[float] = None
+        self._flush_cost = 0.0  # seconds the last flush took
+        self._placed = self.path.exists() and self.replace
+
+    def on_step(self, setup, step) -> None:
+        self.rows.append([get(step) for _, _, get in HISTORY.values()])
+        if step.is_snapshot and (not self.field_cycles or self.field_cycles[-1] != step.cycle):
+            self.field_cycles.append(step.cycle)
+            for name, (_, _, get) in FIELDS.items():
+                self.fields[name].append(np.array(get(step)))
+            loop = step.cycle_result.loop
+            self.loops.append((loop[0] * 1e3, loop[1]) if loop is not None else (np.zeros(0), np.zeros(0)))
+        self.state = step.state
+        # at most every FLUSH_SECONDS, the first FLUSH_SECONDS into the run: each flush rewrites the whole file,
+        # a kill costs at most the steps since the last one (which --resume recomputes), and a run shorter than
+        # that writes its file once, at the end
+        now = time.monotonic()
+        if self._started is None:
+            self._started = self._flushed = now
+        # a flush rebuilds the whole file (tens of ms): never let flushing take more than ~5 % of a long run
+        if now - self._flushed > max(FLUSH_SECONDS, FLUSH_COST_FACTOR * self._flush_cost):
+            self.flush()
+
+    def finish(self, status: str, message: str = "", summary: Optional[dict] = None) -> None:
+        self.status, self.message = status, message
+        self.summary = summary or {}
+        self.flush()
+
+    def image(self) -> bytes:
+        """The whole results file as bytes (an in-memory HDF5 image)."""
+        buf = io.BytesIO()
+        with h5py.File(buf, "w") as f:
+            self._write(f)
+        return buf.getvalue()
+
+    def flush(self) -> None:
+        """Write the whole file beside the target and move it over the target (atomic); ResultsIOError if the
+        disk refuses, with the last good file left as it was and no temporary left behind."""
+        started = time.monotonic()
+        data = self.image()
+        tmp = self.path.with_name(f".fretsim-{os.getpid()}-{os.urandom(4).hex()}.tmp")
+        try:
+            fd = os.open(tmp, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o644)
+            try:
+                view = memoryview(data)
+                while view:
+                    view = view[os.write(fd, view):]
+                os.fsync(fd)
+            finally:
+                os.close(fd)
+            if self._placed:
+                os.replace(tmp, self.path)
+            else:
+                try:
+                    os.link(tmp, self.path)  # fails if the name appeared meanwhile: never clobber
+                except FileExistsError:
+                    if not self.replace:
+                        raise ResultsIOError(errno.EEXIST, f"{self.path} appeared while this run started; nothing "
+                                                           f"of it was replaced") from None
+                    os.replace(tmp, self.path)
+                self._placed = True
+            _fsync_dir(self.path.parent)
+        except ResultsIOError:
+            raise
+        except OSError as exc:
+            what = {errno.ENOSPC: "the disk is full", errno.EDQUOT: "the disk quota is exceeded",
+                    errno.EIO: "an I/O error", errno.ENOENT: "its directory has gone",
+                    errno.EROFS: "the file system is read-only", errno.EACCES: "permission denied"}.get(
+                exc.errno, exc.strerror or str(exc))
+            raise ResultsIOError(exc.errno, f"cannot write {self.path}: {what}") from None
+        finally:
+            try:
+                tmp.unlink()
+            except OSError:
+                pass
+        self._flushed = time.monotonic()
+        self._flush_cost = self._flushed - started
+
+    def _write(self, f: h5py.File) -> None:
+        grid = self.grid
+        text = h5py.string_dtype()
+        w = _SealingWriter(f)
+        w.attrs(f, format_version=FORMAT_VERSION, fretsim_version=__version__, status=self.status,
+                status_message=self.message, case_name=self.case_name, notes="\n".join(self.notes),
+                input_sha256=self.input_sha256)
+        w.dataset(f, "case", self.case_yaml, text,
+                  long_name="the validated case with every default and automatic choice filled (YAML)")
+        self._write_inputs(w, f)
+        ch = w.group(f, "choices")
+        w.dataset(ch, "key", [c.key for c in self.choices], text)
+        w.dataset(ch, "value", [_valuetext(c.value) for c in self.choices], text)
+        w.dataset(ch, "reason", [c.reason for c in self.choices], text)
+        w.dataset(ch, "given", np.array([c.given for c in self.choices], dtype=np.int8))
+        g = w.group(f, "grid")
+        for name, values in (("x", grid.x), ("y", grid.y)):
+            w.dataset(g, name, values, units="mm",
+                      long_name=f"element centre, {'sliding direction' if name == 'x' else 'across it'}")
+        w.attrs(g, dx_mm=grid.dx, dy_mm=grid.dy, plane_strain=np.int8(grid.plane_strain))
+        h = w.group(f, "history")
+        n = len(self.rows)
+        rows = np.array(self.rows, dtype=float).reshape(n, len(HISTORY))
+        step = w.dataset(h, "step", np.arange(n, dtype="i8"), units="1", long_name="accepted step")
+        step.make_scale("step")
+        for j, (name, (units, long_name, _)) in enumerate(HISTORY.items()):
+            data = rows[:, j].astype("i8") if name in INTEGER_HISTORY else rows[:, j]
+            extra = {} if name == "cycle" else {"coordinates": "cycle"}
+            ds = w.dataset(h, name, data, units=units, long_name=long_name, **extra)
+            ds.dims[0].attach_scale(step)
+        fl = w.group(f, "fields")
+        ny, nx = grid.shape
+        cyc = w.dataset(fl, "cycle", np.array(self.field_cycles, dtype="i8"), units="cycles",
+                        long_name="cycle number of the snapshot")
+        cyc.make_scale("cycle")
+        scales = [cyc]
+        for name, values in (("y", grid.y), ("x", grid.x)):
+            ds = w.dataset(fl, name, values, units="mm",
+                           long_name=f"element centre, {'sliding direction' if name == 'x' else 'across it'}")
+            ds.make_scale(name)
+            scales.append(ds)
+        for name, (units, long_name, _) in FIELDS.items():
+            data = np.array(self.fields[name]).reshape(len(self.fields[name]), ny, nx)
+            ds = w.dataset(fl, name, data, units=units, long_name=long_name)
+            for axis, scale in enumerate(scales):
+                ds.dims[axis].attach_scale(scale)
+        lp = w.group(f, "fretting_loop")
+        w.attrs(lp, long_name="the fretting loop at each snapshot: the rig's displacement and the tangential "
+                              "force round one cycle (−δ → +δ → −δ); no points for uniform slip")
+        lcyc = w.dataset(lp, "cycle", np.array(self.field_cycles, dtype="i8"), units="cycles",
+                         long_name="cycle number of the snapshot")
+        lcyc.make_scale("cycle")
+        points = max((len(u) for u, _ in self.loops), default=0)
+        for name, k, units, long_name in (("displacement", 0, "um", "the rig's tangential displacement"),
+                                          ("tangential_force", 1, "N", "the tangential force Q (total)")):
+            data = np.full((len(self.loops), points), np.nan)
+            for i, pair in enumerate(self.loops):
+                data[i, :len(pair[k])] = pair[k]
+            ds = w.dataset(lp, name, data, units=units, long_name=long_name)
+            ds.dims[0].attach_scale(lcyc)
+        s = w.group(f, "summary")
+        for key, value in self.summary.items():
+            w.dataset(s, key, value, units=SUMMARY_UNITS.get(key, "1"), long_name=summary_long_name(key))
+        w.attrs(s, **self.summary)
+        if self.summary:
+            w.attrs(s, units=", ".join(f"{k}: {SUMMARY_UNITS.get(k, '1')}" for k in self.summary))
+        if self.state is not None:  # not sealed: it carries its own digest (but the root names it)
+            c = w.unsealed_group(f, "checkpoint")
+            for key, value in self.state.items():
+                if isinstance(value, np.ndarray):
+                    c.create_dataset(key, data=value)
+                elif isinstance(value, list):  # a list of arrays (the schemes' memory)
+                    c.create_dataset(key, data=np.array(value)) if value else c.attrs.__setitem__(key + "_empty", 1)
+                elif value is not None:
+                    c.attrs[key] = value
+            c.attrs["sha256"] = checkpoint_digest(self.state)
+        w.seal()
+
+    def _write_inputs(self, w: "_SealingWriter", f: h5py.File) -> None:
+        g = w.group(f, "inputs")
+        for key, (value, units, long_name) in self.inputs.get("values", {}).items():
+            w.dataset(g, key, value, h5py.string_dtype() if isinstance(value, str) else None, units=units,
+                      long_name=long_name)
+        w.attrs(g, overrides=json.dumps(list(self.inputs.get("overrides", []))),
+                case_file=str(self.inputs.get("case_file", "")))
+
+
+def _fsync_dir(directory: Path) -> None:
+    try:
+        fd = os.open(directory if str(directory) else ".", os.O_RDONLY)
+    except OSError:
+        return
+    try:
+        os.fsync(fd)
+    except OSError:
+        pass
+    finally:
+        os.close(fd)
+
+
+def _valuetext(value) -> str:
+    if isinstance(value, tuple):
+        return "[" + ", ".join(repr(v) for v in value) + "]"
+    return str(value)
+
+
