@@ -557,87 +557,102 @@ class _Reader:
         return self.value(value, spec, path)
 
     def value(self, value: Any, spec: Key, path: str) -> Any:
+        """A value of its schema's kind (None, with the problem recorded, if it is not one)."""
         kind = spec.kind
         if kind in UNITS:
             return self.quantity(value, spec, path)
-        if kind == "number":
-            return self.number(value, spec, path)
-        if kind == "fraction":
-            if isinstance(value, str) and value.strip().endswith("%"):
-                num = value.strip()[:-1].strip()
-                try:
-                    value = float(num) / 100.0
-                except ValueError:
-                    self.fail(path, f"could not read {excerpt(value)}; expected e.g. '1 %' or 0.01")
-                    return None
-            return self.number(value, spec, path)
-        if kind == "integer":
-            return self.integer(value, spec, path)
-        if kind == "choice":
-            # exact, like the keys ("Stroke" is not "stroke"); a near miss gets a hint
-            if isinstance(value, str) and spec.any_case:
-                value = value.lower()
-            if isinstance(value, str) and value in spec.choices:
-                return value
-            hint = difflib.get_close_matches(str(value).lower(), spec.choices, n=1) if isinstance(value, str) else []
-            self.fail(path, f"unknown value {excerpt(value)}" + (f" (did you mean '{hint[0]}'?)" if hint else "")
-                      + f"; expected one of {', '.join(spec.choices)}")
+        return getattr(self, "_" + kind)(value, spec, path)
+
+    def _fraction(self, value: Any, spec: Key, path: str) -> Optional[float]:
+        if isinstance(value, str) and value.strip().endswith("%"):
+            num = value.strip()[:-1].strip()
+            try:
+                value = float(num) / 100.0
+            except ValueError:
+                self.fail(path, f"could not read {excerpt(value)}; expected e.g. '1 %' or 0.01")
+                return None
+        return self.number(value, spec, path)
+
+    def _number(self, value: Any, spec: Key, path: str) -> Optional[float]:
+        return self.number(value, spec, path)
+
+    def _integer(self, value: Any, spec: Key, path: str) -> Optional[int]:
+        return self.integer(value, spec, path)
+
+    def _choice(self, value: Any, spec: Key, path: str) -> Optional[str]:
+        # exact, like the keys ("Stroke" is not "stroke"); a near miss gets a hint
+        if isinstance(value, str) and spec.any_case:
+            value = value.lower()
+        if isinstance(value, str) and value in spec.choices:
+            return value
+        hint = difflib.get_close_matches(str(value).lower(), spec.choices, n=1) if isinstance(value, str) else []
+        self.fail(path, f"unknown value {excerpt(value)}" + (f" (did you mean '{hint[0]}'?)" if hint else "")
+                  + f"; expected one of {', '.join(spec.choices)}")
+        return None
+
+    def _pair(self, value: Any, spec: Key, path: str) -> Optional[tuple]:
+        lengths = spec.kind == "lengths"
+        item = Key("length", "") if lengths else Key("integer", "", lo=spec.lo, hi=spec.hi)
+        if not isinstance(value, list) or not 1 <= len(value) <= 2:
+            self.fail(path, f"expected a list of one (2d) or two (3d) {'lengths' if lengths else 'whole numbers'}"
+                            f", e.g. {'[1 mm, 10 mm]' if lengths else '[101, 27]'}")
             return None
-        if kind in ("lengths", "counts"):
-            item = Key("length", "") if kind == "lengths" else Key("integer", "", lo=spec.lo, hi=spec.hi)
-            if not isinstance(value, list) or not 1 <= len(value) <= 2:
-                self.fail(path, f"expected a list of one (2d) or two (3d) {'lengths' if kind == 'lengths' else 'whole numbers'}"
-                                f", e.g. {'[1 mm, 10 mm]' if kind == 'lengths' else '[101, 27]'}")
-                return None
-            vals = [self.value(v, item, f"{path}[{i}]") for i, v in enumerate(value)]
-            return None if None in vals else tuple(vals)
-        if kind == "text":
-            if not isinstance(value, str) or not value.strip():
-                self.fail(path, f"expected a text, got {excerpt(value)}")
-                return None
+        vals = [self.value(v, item, f"{path}[{i}]") for i, v in enumerate(value)]
+        return None if None in vals else tuple(vals)
+
+    _lengths = _counts = _pair
+
+    def _text(self, value: Any, spec: Key, path: str) -> Optional[str]:
+        if not isinstance(value, str) or not value.strip():
+            self.fail(path, f"expected a text, got {excerpt(value)}")
+            return None
+        return value
+
+    def _profile_file(self, value: Any, spec: Key, path: str):
+        if not isinstance(value, str) or not value.strip():
+            self.fail(path, f"expected the name of a CSV file, got {excerpt(value)}")
+            return None
+        return _read_profile(value, self.source, self, path)
+
+    def _table(self, value: Any, spec: Key, path: str):
+        ok = isinstance(value, dict) and set(value) == {"y", "drop"} and all(
+            isinstance(value[k], list) and len(value[k]) >= 2 for k in ("y", "drop")) and len(value["y"]) == len(
+            value["drop"])
+        if not ok:
+            self.fail(path, "expected {y: [lengths], drop: [lengths]} of equal length, at least two each")
+            return None
+        length = Key("length", "", positive=False)
+        ys = [self.quantity(v, length, f"{path}.y[{i}]") for i, v in enumerate(value["y"])]
+        ds = [self.quantity(v, length, f"{path}.drop[{i}]") for i, v in enumerate(value["drop"])]
+        if None in ys or None in ds:
+            return None
+        if not (np.diff(ys) > 0).all():
+            self.fail(path, "y must increase")
+            return None
+        return tuple(ys), tuple(ds)
+
+    def _corrections(self, value: Any, spec: Key, path: str):
+        if isinstance(value, str) and value in ("auto", "none"):
             return value
-        if kind == "profile_file":
-            if not isinstance(value, str) or not value.strip():
-                self.fail(path, f"expected the name of a CSV file, got {excerpt(value)}")
-                return None
-            return _read_profile(value, self.source, self, path)
-        if kind == "table":
-            ok = isinstance(value, dict) and set(value) == {"y", "drop"} and all(
-                isinstance(value[k], list) and len(value[k]) >= 2 for k in ("y", "drop")) and len(value["y"]) == len(
-                value["drop"])
-            if not ok:
-                self.fail(path, "expected {y: [lengths], drop: [lengths]} of equal length, at least two each")
-                return None
-            length = Key("length", "", positive=False)
-            ys = [self.quantity(v, length, f"{path}.y[{i}]") for i, v in enumerate(value["y"])]
-            ds = [self.quantity(v, length, f"{path}.drop[{i}]") for i, v in enumerate(value["drop"])]
-            if None in ys or None in ds:
-                return None
-            if not (np.diff(ys) > 0).all():
-                self.fail(path, "y must increase")
-                return None
-            return tuple(ys), tuple(ds)
-        if kind == "corrections":
-            if isinstance(value, str) and value in ("auto", "none"):
-                return value
-            items = value if isinstance(value, list) else None
-            if items is None or not all(isinstance(v, str) and v in CORRECTIONS for v in items):
-                self.fail(path, f"expected auto, none, or a list of {', '.join(CORRECTIONS)}; got {excerpt(value)}")
-                return None
-            return tuple(sorted(set(items)))
-        if kind == "blocks":  # read item by item by _read_blocks, with the loading's own key specs
-            return value
-        if kind == "cycle_list":
-            if not isinstance(value, list):
-                self.fail(path, "expected a list of cycle numbers, e.g. [1000, 5000, 18000]")
-                return None
-            if len(value) > 10_000:
-                self.fail(path, f"{len(value)} snapshots; at most 10000")
-                return None
-            vals = [self.integer(v, Key("integer", "", lo=0, hi=MAX_CYCLES), f"{path}[{i}]")
-                    for i, v in enumerate(value)]
-            return None if None in vals else tuple(sorted(set(vals)))
-        raise AssertionError(kind)
+        items = value if isinstance(value, list) else None
+        if items is None or not all(isinstance(v, str) and v in CORRECTIONS for v in items):
+            self.fail(path, f"expected auto, none, or a list of {', '.join(CORRECTIONS)}; got {excerpt(value)}")
+            return None
+        return tuple(sorted(set(items)))
+
+    def _blocks(self, value: Any, spec: Key, path: str):
+        return value  # read item by item by _read_blocks, with the loading's own key specs
+
+    def _cycle_list(self, value: Any, spec: Key, path: str) -> Optional[tuple]:
+        if not isinstance(value, list):
+            self.fail(path, "expected a list of cycle numbers, e.g. [1000, 5000, 18000]")
+            return None
+        if len(value) > 10_000:
+            self.fail(path, f"{len(value)} snapshots; at most 10000")
+            return None
+        vals = [self.integer(v, Key("integer", "", lo=0, hi=MAX_CYCLES), f"{path}[{i}]")
+                for i, v in enumerate(value)]
+        return None if None in vals else tuple(sorted(set(vals)))
 
     def quantity(self, value: Any, spec: Key, path: str) -> Optional[float]:
         if path == "loading.stroke" and isinstance(value, str) and value.lstrip().startswith(("±", "+/-")):
@@ -785,12 +800,12 @@ def _read_blocks(r: "_Reader", raw_load: dict, load: dict, given: list) -> tuple
     if spectrum:
         total = sum(b.fraction for b in out)
         if abs(total - 1.0) > 1e-6:
-            r.fail(f"loading.spectrum", f"the fractions add up to {total:.6g}; expected 1")
+            r.fail("loading.spectrum", f"the fractions add up to {total:.6g}; expected 1")
             return None, 1
         if load.get("cycles") is None:
             return None, 1
     elif sum(b.cycles for b in out) == 0:
-        r.fail(f"loading.blocks", "every block has 0 cycles")
+        r.fail("loading.blocks", "every block has 0 cycles")
         return None, 1
     return tuple(out), load.get("repeat") or 1
 
