@@ -43,7 +43,7 @@ from typing import Optional
 import numpy as np
 
 from fretsim.compliance import scaled
-from fretsim.cycle import Cycle, CycleError, CycleSpec, stick_half_width
+from fretsim.cycle.result import Cycle, CycleError, CycleSpec, stick_half_width
 from fretsim.grid import Grid
 from fretsim.solvers.tangential import solve_tangential
 from fretsim.wear import gap_wear, sweep_deposit, sweep_read, wear_operator

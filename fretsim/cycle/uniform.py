@@ -15,7 +15,7 @@ from typing import Optional
 import numpy as np
 
 from fretsim.compliance import scaled
-from fretsim.cycle import Cycle, CycleSpec
+from fretsim.cycle.result import Cycle, CycleSpec
 from fretsim.grid import Grid
 from fretsim.solvers.result import ContactResult
 from fretsim.wear import archard_volume, gap_wear, stroke_average, wear_operator, wear_rates
