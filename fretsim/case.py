@@ -24,6 +24,7 @@ from fretsim.errors import InputError
 from fretsim.geometry import GEOMETRIES, Geometry
 from fretsim.loading import Block, Loading, expand
 from fretsim.quantities import WEAR
+from fretsim.stepping import DEFAULT_SCHEME, SCHEMES
 from fretsim.units import UNITS, UnitError, format_quantity, parse_quantity
 from fretsim.wear_laws import WEAR_LAWS, gross_slip_coefficients
 from fretsim.yamlread import YamlProblem, excerpt, loads, read_text
@@ -50,11 +51,9 @@ class Names:
         return tuple(self)[i]
 
 
-SCHEMES = ("bdf2", "implicit", "linear", "adaptive")
 # the paper's DOE optimum (section 3.1): η = 0.55, ΔN_max = 600, ΔN_L = 55
 PRESETS = {"paper": {"scheme": "adaptive", "eta": 0.55, "max": 600}}
 PRESET_LINEAR = {"paper": 55}  # a preset's ΔN_L: not filled into the case, the planner scales it to the grid
-DEFAULT_SCHEME = "bdf2"
 DIMENSIONS = ("2d", "3d", "auto")
 GAP_MODELS = ("auto", "mid_stroke", "stroke_average")
 SLIP_MODELS = Names(CYCLES, ("auto",))
@@ -216,7 +215,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
                                    "(and the gap complementary)", 1e-5, lo=1e-14, hi=1e-2)},
     "jumping": {
         "scheme": Key("choice", "bdf2 (second-order implicit, default), implicit (backward Euler), linear "
-                                "(the paper's explicit ΔN_L) or adaptive (Eqs. 19–21)", None, choices=SCHEMES),
+                                "(the paper's explicit ΔN_L) or adaptive (Eqs. 19–21)", None, choices=Names(SCHEMES)),
         "tolerance": Key("fraction", "implicit schemes: target relative error of the recorded depths and "
                                      "pressures", 0.01, lo=1e-6, hi=0.5),
         "linear": Key("integer", "ΔN_L, cycles per explicit step (auto: half the stability limit)", None, lo=1,

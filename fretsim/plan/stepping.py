@@ -11,11 +11,11 @@ import math
 from dataclasses import dataclass
 from typing import Optional
 
-from fretsim.case import DEFAULT_SCHEME, PRESET_LINEAR, Case, CaseError
+from fretsim.case import PRESET_LINEAR, Case, CaseError
 from fretsim.grid import Grid
 from fretsim.plan.choices import Choice, Plan
 from fretsim.stability import Spectrum, combined, default_linear_jump, wear_spectrum
-from fretsim.stepping import SCHEMES
+from fretsim.stepping import DEFAULT_SCHEME, SCHEMES
 
 MODEL_GROWTH = math.log(1e3)  # a forced unstable model may grow a seed at most 1000-fold over the run
 SHORT_RUN = 8  # runs of at most this many cycles are taken a cycle at a time: exact, and as cheap
