@@ -254,7 +254,8 @@ def test_a_format_1_1_file_is_still_read(results_3d, tmp_path):
 
 MODULES = ROOT / "fretsim"
 PHYSICS = ["compliance", "geometry", "grid", "jumping", "refine", "sizing", "stability", "solvers", "wear",
-           "simulate", "reference", "cycle", "loading"]
+           "simulate", "reference", "cycle", "loading", "wear_laws", "stepping", "loop", "measures", "quantities",
+           "limits"]
 
 
 def _imports(path: Path) -> set:
