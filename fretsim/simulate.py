@@ -22,8 +22,7 @@ import numpy as np
 
 from fretsim.compliance import add
 from fretsim.cycle import Cycle, CycleError
-from fretsim.errors import (DomainError, NumericalFailure, PhysicalLimit, ResolutionError,  # noqa: F401 - the
-                            SimulationError)  # loop's failures, importable from here as before
+from fretsim.errors import DomainError, NumericalFailure, PhysicalLimit, ResolutionError, SimulationError
 from fretsim.geometry import Limits
 from fretsim.grid import Grid
 from fretsim.loading import Loading
@@ -34,7 +33,10 @@ from fretsim.refine import coarsen, refine_pressure
 from fretsim.solvers import solve
 from fretsim.stability import GrowthWatch, checkerboard_signed
 from fretsim.stepping import SCHEMES, relative_change
-from fretsim.stepping.implicit import DEPTH_SHARE  # noqa: F401 - the depths' share of the tolerance, as before
+from fretsim.stepping.implicit import DEPTH_SHARE
+
+__all__ = ["DEPTH_SHARE", "DomainError", "NumericalFailure", "Observer", "PhysicalLimit", "ResolutionError", "Setup",
+           "SimulationError", "Step", "simulate", "summarize"]
 
 
 @dataclass(frozen=True)

@@ -1,15 +1,16 @@
 """What friction costs, and what its increments buy.
 
-1. The uniform model against the previous release, side by side: ``FRETSIM_BASELINE=/path/to/old/checkout python
-   scripts/bench_friction.py`` runs McColl 185 N (3D, 18 000 cycles) with this tree and with that one in turn, in
-   fresh processes, and takes the ratio of the loop times pair by pair (skipped without the variable).
+1. The loops against a previous tree, side by side: ``python scripts/bench_friction.py --vs /path/to/old/checkout``
+   (or ``FRETSIM_BASELINE=...``) runs McColl 185 N with the uniform model (3D, 18 000 cycles) and with Coulomb
+   friction at mid-stroke (μ = 0.9, 2D and 3D) with this tree and with that one in turn, in fresh processes, and
+   takes the ratio of the loop times pair by pair (skipped without a baseline; ``--vs-only`` stops there).
 2. The loop time of McColl 185 N at μ = 0.9 under each cycle model, 2D and 3D (medians of 3).
 3. Increments per half-stroke against accuracy: with the pressure at mid-stroke a half-stroke is one monotone
    increment, so the wear does not depend on their number (they only draw the loop); with the stroke resolved
    the pressure changes along it and the increments are a quadrature — the chart shows the depth error against
    the loop time (McColl 500 N, 2D, against 65 increments).
 
-    python scripts/bench_friction.py [--quick]
+    python scripts/bench_friction.py [--quick] [--vs OLD_TREE [--vs-only]]
 
 Prints tables; writes scripts/out/bench_friction.{txt,csv,png}.
 """
@@ -41,20 +42,38 @@ def loop_seconds(tree: str, case: str, overrides: list[str]) -> float:
     return float(json.loads(out.stdout.strip().splitlines()[-1]))
 
 
-def main(quick: bool = False) -> None:
+VERSUS = (("uniform, 3D", []), ("coulomb (mid-stroke), 2D", [MU, "model.slip=coulomb", "model.dimension=2d"]),
+          ("coulomb (mid-stroke), 3D", [MU, "model.slip=coulomb", "model.dimension=3d"]))
+
+
+def versus(baseline: str, pairs: int, say: Report, rows: list) -> None:
+    """This tree's loop time over the baseline's, pair by pair (each pair run back to back, this tree first)."""
+    case = str(ROOT / "cases" / "mccoll_185N.yaml")
+    say(f"the loop against {baseline}: McColl 185 N, 18 000 cycles, {pairs} pairs each (fresh processes)")
+    say(f"{'model':<28}{'this s':>9}{'old s':>9}{'ratio':>8}{'min':>7}{'max':>7}")
+    for label, sets in VERSUS:
+        ratios, a_s, b_s = [], [], []
+        for _ in range(pairs):
+            a, b = loop_seconds(str(ROOT), case, sets), loop_seconds(baseline, case, sets)
+            a_s.append(a), b_s.append(b), ratios.append(a / b)
+        say(f"{label:<28}{np.median(a_s):>9.3f}{np.median(b_s):>9.3f}{np.median(ratios):>8.3f}{min(ratios):>7.3f}"
+            f"{max(ratios):>7.3f}")
+        rows.append({"what": f"{label} vs baseline", "this_s": float(np.median(a_s)), "baseline_s": float(np.median(b_s)),
+                     "ratio_median": float(np.median(ratios)), "ratio_min": min(ratios), "ratio_max": max(ratios)})
+
+
+def main(quick: bool = False, baseline: str = "", vs_only: bool = False) -> None:
     say = Report()
     rows = []
     case = str(ROOT / "cases" / "mccoll_185N.yaml")
-    baseline = os.environ.get("FRETSIM_BASELINE")
     if baseline:
-        pairs = 3 if quick else 7
-        ratios, a_s, b_s = [], [], []
-        for _ in range(pairs):
-            a, b = loop_seconds(str(ROOT), case, []), loop_seconds(baseline, case, [])
-            a_s.append(a), b_s.append(b), ratios.append(a / b)
-        say(f"uniform model, McColl 185 N 3D, loop: this tree {np.median(a_s):.3f} s, {baseline} {np.median(b_s):.3f} s;"
-            f" ratio per pair median {np.median(ratios):.3f} (min {min(ratios):.3f}, max {max(ratios):.3f}), {pairs} pairs")
-        rows.append({"what": "uniform vs baseline", "ratio_median": float(np.median(ratios))})
+        versus(baseline, 3 if quick else 7, say, rows)
+        if vs_only:
+            OUT.mkdir(parents=True, exist_ok=True)
+            say.write(OUT / "bench_friction_vs.txt")
+            write_csv(rows, OUT / "bench_friction_vs.csv")
+            print(f"wrote {OUT / 'bench_friction_vs.txt'}, .csv")
+            return
     say("")
     say("McColl 185 N, μ = 0.9, 18 000 cycles: loop time (s, median of 3) and the flat's centre-line depth")
     say(f"{'model':<28}{'dim':<5}{'loop s':>9}{'solves':>8}{'depth µm':>10}  status")
@@ -115,4 +134,6 @@ def main(quick: bool = False) -> None:
 
 
 if __name__ == "__main__":
-    main("--quick" in sys.argv)
+    args = sys.argv[1:]
+    vs = args[args.index("--vs") + 1] if "--vs" in args else os.environ.get("FRETSIM_BASELINE", "")
+    main("--quick" in args, vs, "--vs-only" in args)

@@ -15,6 +15,10 @@ from __future__ import annotations
 
 from typing import Optional, Protocol
 
+from fretsim.stepping.adaptive import Adaptive
+from fretsim.stepping.implicit import Implicit
+from fretsim.stepping.linear import Linear, relative_change
+
 
 class Scheme(Protocol):
     name: str
@@ -40,10 +44,8 @@ class Scheme(Protocol):
         """Step ``loop`` to its last cycle; the last accepted step (None if none was taken)."""
 
 
-from fretsim.stepping.adaptive import Adaptive  # noqa: E402 - the members need the interface above
-from fretsim.stepping.implicit import Implicit  # noqa: E402
-from fretsim.stepping.linear import Linear, relative_change  # noqa: E402
-
 SCHEMES: dict[str, Scheme] = {"bdf2": Implicit("bdf2", order=2), "implicit": Implicit("implicit", order=1),
                               "linear": Linear(), "adaptive": Adaptive()}
 DEFAULT_SCHEME = "bdf2"
+
+__all__ = ["DEFAULT_SCHEME", "SCHEMES", "Adaptive", "Implicit", "Linear", "Scheme", "relative_change"]

@@ -4,8 +4,6 @@ from __future__ import annotations
 
 from typing import Optional
 
-import numpy as np
-
 from fretsim.errors import NumericalFailure
 from fretsim.jumping import Q_LINEAR, taylor_extrapolate, taylor_jump
 from fretsim.stability import NOISE_FLOOR, checkerboard_signed
