@@ -224,12 +224,13 @@ class _Sink:
             self.writer.notes = tuple(dict.fromkeys(self.writer.notes + tuple(counter.notes)))
             self.writer.finish(status, message, _summary(self.setup, counter, t0))
 
-    def finish_interrupted(self, counter, t0, message: str) -> None:
-        """Record an interruption: a second Ctrl-C must not interrupt the write that records the first, and a disk
-        that refuses leaves the last good flush (status 'running'), still resumable."""
+    def finish_interrupted(self, counter, t0, message: Callable[[], str]) -> None:
+        """Record an interruption: signals are ignored first thing, so that a second Ctrl-C cannot interrupt the write
+        that records the first, and a disk that refuses leaves the last good flush (status 'running'), still
+        resumable."""
         previous = _ignore_signals()
         try:
-            self.finish(counter, t0, "interrupted", message)
+            self.finish(counter, t0, "interrupted", message())
         except ResultsIOError:
             pass
         finally:
@@ -252,9 +253,9 @@ def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from:
         return Outcome("io_error", f"{exc.strerror}; {where}", _summary(setup, counter, t0), setup, filled,
                        Path(output), counter.last, setup.notes, plan, cycle is not None)
     except KeyboardInterrupt:
-        cycle = counter.last.cycle if counter.last else (int(state["n"]) if state else 0)
-        sink.finish_interrupted(counter, t0, f"interrupted after cycle {cycle}; resume with `fretsim run --resume "
-                                             f"{output}`")
+        sink.finish_interrupted(counter, t0, lambda: f"interrupted after cycle "
+                                f"{counter.last.cycle if counter.last else (int(state['n']) if state else 0)}; "
+                                f"resume with `fretsim run --resume {output}`")
         raise
     if status == "complete" and counter.last is not None:
         _estimate_errors(setup, filled, plan, counter, sink, t0, runs)
@@ -302,8 +303,8 @@ def _estimate_errors(setup, filled, plan, counter, sink: _Sink, t0, runs: SideRu
     try:
         counter.extra = _error_estimates(setup, filled, plan, counter, runs)
     except KeyboardInterrupt:
-        sink.finish_interrupted(counter, t0, "interrupted while estimating the grid's error (the run itself is "
-                                             f"complete); resume with `fretsim run --resume {sink.output}`")
+        sink.finish_interrupted(counter, t0, lambda: "interrupted while estimating the grid's error (the run itself "
+                                f"is complete); resume with `fretsim run --resume {sink.output}`")
         raise
     except Exception as exc:  # noqa: BLE001 - the run is complete: whatever stops its error estimate must not
         #                                      cost it its file; the estimates are then unknown, and it says why

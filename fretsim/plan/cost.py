@@ -6,6 +6,8 @@ import time
 import numpy as np
 
 from fretsim.compliance import add
+from fretsim.compliance import fft
+from fretsim.solvers import solve
 
 # a step's solve, warm-started on the contact's window, against the cold solve timed (loop time per solve over one
 # cold solve, measured on McColl 185 N 2D/3D with BDF2 and linear jumps, Kirk 20 Hz, the 3D tube, the partial-slip
@@ -23,8 +25,6 @@ def estimate_solves(setup) -> int:
 
 def estimate_cost(setup) -> tuple[int, float]:
     """(solves, seconds) before a run: solves from the scheme, seconds from one timed contact solve."""
-    from fretsim.compliance import fft
-    from fretsim.solvers import solve
     fft.forward(np.zeros((1, 3)), (1, 6))  # the FFT's import and choice, once a process: not a solve's cost
     solves = estimate_solves(setup)
     op = setup.coarse_compliance or setup.compliance

@@ -12,11 +12,13 @@ from typing import Optional
 
 from fretsim import cycle as family
 from fretsim.case import Case, CaseError
+from fretsim.compliance.tangential import Tangential
 from fretsim.cycle import CYCLES, STROKES
 from fretsim.cycle.coulomb import gross_slip_stroke
 from fretsim.grid import Grid
 from fretsim.loading import Block
 from fretsim.plan.choices import Choice, Plan
+from fretsim.reference.mindlin import dundurs_beta
 from fretsim.solvers import solve
 
 
@@ -42,7 +44,6 @@ class Cycles:
 def tangential_operator(case: Case, grid: Grid):
     """Both bodies' tangential compliance on the grid, the 2D datum and the rig's compliance
     (:mod:`fretsim.compliance.tangential`)."""
-    from fretsim.compliance.tangential import Tangential
     plane = grid.plane_strain
     volume_factor = case.geometry.line_length if plane else 1.0
     k_t = case.loading.tangential_stiffness
@@ -161,7 +162,6 @@ def _check_incremental(case: Case, grids, model, plan: Plan, transition: Optiona
                                                                   " (this stroke is in partial slip, where uniform "
                                                                   "slip is refused)" if partial else
                                                                   ", or use model.slip: uniform"))])
-    from fretsim.reference.mindlin import dundurs_beta
     beta = dundurs_beta(case.moving.youngs_modulus, case.moving.poissons_ratio, case.stationary.youngs_modulus,
                         case.stationary.poissons_ratio)
     mu = case.loading.friction_coefficient or 0.0

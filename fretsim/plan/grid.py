@@ -17,7 +17,7 @@ from fretsim.grid import Grid
 from fretsim.plan.choices import Choice, Plan
 from fretsim.plan.inputs import MEMORY_SHARE, Contact, available_memory, memory_estimate
 from fretsim.plan.model import choose_gap_model
-from fretsim.sizing import Sizing, auto_grid
+from fretsim.sizing import ELEMENTS_OVER_7A, Sizing, auto_grid
 from fretsim.wear import GAP_REACH, stroke_reach
 
 PARTIAL_SLIP_ELEMENTS = 4  # across the stick zone and across the slip annulus, at least (as across a contact)
@@ -193,7 +193,6 @@ def partial_slip_refinement(case: Case, slip: str, transition: Optional[float], 
 
 def refined(case: Case, slip: str, transition: Optional[float], contact: Contact, refine: float) -> Optional[float]:
     """The refinement the automatic grid needs for partial slip, if it has not had it yet (None: plan on)."""
-    from fretsim.sizing import ELEMENTS_OVER_7A
     if refine != 1.0 or case.elements is not None:
         return None
     # the same case on the grid partial slip needs, within a cap: a tiny stroke's annulus would need thousands

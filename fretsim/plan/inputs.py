@@ -13,6 +13,7 @@ from dataclasses import dataclass
 from fretsim.case import Case, CaseError
 from fretsim.plan.choices import Choice, Plan
 from fretsim.reference import effective_modulus
+from fretsim.solvers import DENSE_SOLVERS
 
 MAX_STROKE_OVER_CONTACT = 50.0  # δ/a beyond this is sliding, not fretting, or a unit slip (µm → mm)
 MEMORY_SHARE = 0.5  # refuse a grid that would take more than this share of the machine's memory
@@ -105,7 +106,6 @@ def available_memory() -> int:
 def memory_estimate(elements: int, snapshots: int, solver: str, coarse_elements: int = 0) -> float:
     """Bytes a run needs: ~40 work arrays, FFT buffers (4x, complex), 4 fields per snapshot, the implicit
     schemes' history (3 arrays × 8 points), a dense matrix for the dense solvers (on the grid solved on)."""
-    from fretsim.solvers import DENSE_SOLVERS
     solved = coarse_elements or elements
     need = 8.0 * elements * (40 + 24 + 4 * snapshots) + 8.0 * solved * 4 * 2 * 4
     if solver in DENSE_SOLVERS:

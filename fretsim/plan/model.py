@@ -18,10 +18,12 @@ import numpy as np
 
 from fretsim.case import Case, CaseError
 from fretsim.compliance import HalfSpace, add
+from fretsim.compliance.free_faces import free_faces
 from fretsim.grid import Grid
 from fretsim.plan.choices import Choice, Plan
 from fretsim.plan.runs import SideRuns
 from fretsim.quantities import SAID
+from fretsim.reference import effective_modulus
 from fretsim.simulate import SimulationError, summarize
 from fretsim.sizing import auto_grid
 from fretsim.wear import stroke_symbol
@@ -82,7 +84,6 @@ def operator(case: Case, corrections: tuple, on: Grid, e_star: float):
     extra = [g.extra_compliance(on, case.moving.youngs_modulus, case.moving.poissons_ratio)
              for c in corrections if c == "ring_bending"]
     if "free_faces" in corrections:
-        from fretsim.compliance.free_faces import free_faces
         bodies = {"moving": case.moving, "stationary": case.stationary}
         try:
             extra.append(free_faces(on, [(length, bodies[b].youngs_modulus, bodies[b].poissons_ratio)
@@ -288,7 +289,6 @@ def _correction_proxies(case: Case, corrections: tuple, dimension: str, runs: Si
 
 
 def _e_star(case: Case) -> float:
-    from fretsim.reference import effective_modulus
     return effective_modulus(case.moving.youngs_modulus, case.moving.poissons_ratio,
                              case.stationary.youngs_modulus, case.stationary.poissons_ratio)
 
