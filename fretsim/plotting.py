@@ -22,15 +22,11 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import MaxNLocator, ScalarFormatter  # noqa: E402
 
+from fretsim.measures import centre_line  # noqa: E402
+from fretsim.quantities import SUMMARY  # noqa: E402
 from fretsim.results import Results, ResultsFileError, SweepTable  # noqa: E402
 
 STYLES = ["-", "--", "-.", ":", (0, (5, 1)), (0, (3, 1, 1, 1))]
-
-
-def centre_row(field_2d: np.ndarray) -> np.ndarray:
-    """Values along y = 0: the middle row, or the mean of the two middle rows when My is even."""
-    ny = field_2d.shape[0]
-    return field_2d[ny // 2] if ny % 2 else 0.5 * (field_2d[ny // 2 - 1] + field_2d[ny // 2])
 
 
 def _input(res: Results, key: str, default=None):
@@ -218,7 +214,7 @@ def overlay(results: list, expected: bool = False):
         colour = f"C{k % 10}"
         last = len(res.fields["cycle"]) - 1
         for col, body in enumerate(("stationary", "moving")):
-            row = centre_row(res.fields[f"wear_depth_{body}"][last])
+            row = centre_line(res.fields[f"wear_depth_{body}"][last])
             axes[0, col].plot(res.x, -row, color=colour, label=f"{label}, {_cycles_label(res.fields['cycle'][last])}")
             axes[1, col].plot(res.history["cycle"], res.history[f"max_wear_depth_{body}"], color=colour,
                               marker=".", ms=3, label=label)
@@ -316,14 +312,14 @@ def _profiles(res: Results):
     for col, body in enumerate(("moving", "stationary")):
         data = res.fields[f"wear_depth_{body}"]
         ax = axes[0, col]
-        _snapshot_lines(ax, res.x, [centre_row(data[k]) for k in worn], labels, sign=-1.0)
+        _snapshot_lines(ax, res.x, [centre_line(data[k]) for k in worn], labels, sign=-1.0)
         ax.set_xlabel("x, sliding direction (mm)")
         ax.set_ylabel(f"worn profile, −depth ({unit})")
         ax.set_title(f"{body} body, across the contact (y = 0)")
         if three_d:
             ax = axes[1, col]
             last = data[worn[-1]]
-            ix = int(np.argmax(centre_row(last)))
+            ix = int(np.argmax(centre_line(last)))
             _snapshot_lines(ax, res.y, [data[k][:, ix] for k in worn], labels, sign=-1.0)
             ax.set_xlabel("y, across the sliding direction (mm)")
             ax.set_ylabel(f"worn profile, −depth ({unit})")
@@ -358,7 +354,7 @@ def _pressure(res: Results):
                                         ("pressure_stationary_average", "stationary body (stroke average)"))):
         data = res.fields[name]
         ax = axes[0, col]
-        rows = [centre_row(d) for d in data]
+        rows = [centre_line(d) for d in data]
         _snapshot_lines(ax, res.x, rows, labels)
         if name == "pressure" and hertz is not None and 0 in cycles and _input(res, "hertz_line_contact", 1) in (1, 0):
             ax.plot(res.x, hertz, "k:", lw=1.0, label="Hertz (N = 0)")
@@ -535,7 +531,7 @@ def _fretting(res: Results):
     last = len(res.fields["cycle"]) - 1
     unit = _unit(res, "fields/slip_distance_moving")
     for body, ls in (("moving", "-"), ("stationary", "--")):
-        ax.plot(res.x, centre_row(res.fields[f"slip_distance_{body}"][last]), ls=ls, lw=1.3, label=f"{body} body")
+        ax.plot(res.x, centre_line(res.fields[f"slip_distance_{body}"][last]), ls=ls, lw=1.3, label=f"{body} body")
     stroke = _float(res, "stroke")
     if stroke is not None:
         ax.axhline(4 * stroke, color="k", lw=0.8, ls=":", label="4δ (uniform slip)")
@@ -553,9 +549,9 @@ def _fretting(res: Results):
         ax.set_title("stick and slip on the moving body")
     else:
         mu = _float(res, "friction_coefficient")
-        ax.plot(res.x, centre_row(res.fields["shear_traction"][last]), lw=1.3, label="|q| amplitude")
+        ax.plot(res.x, centre_line(res.fields["shear_traction"][last]), lw=1.3, label="|q| amplitude")
         if mu is not None:
-            ax.plot(res.x, mu * centre_row(res.fields["pressure"][last]), "k:", lw=1.0, label="μp (slip where reached)")
+            ax.plot(res.x, mu * centre_line(res.fields["pressure"][last]), "k:", lw=1.0, label="μp (slip where reached)")
         ax.set_ylabel(f"shear traction ({_unit(res, 'fields/shear_traction')})")
         ax.set_title("stick (|q| < μp) and slip")
         ax.legend(fontsize=8)
@@ -599,7 +595,7 @@ def plot_sweep(table: SweepTable, outdir: str | Path, fmt: str = "png", dpi: int
         for ax, out in zip(ax_list[0], SWEEP_OUTPUTS):
             unit = table.units.get(axis, "")
             ax.set_xlabel(f"{axis} ({unit})" if unit and unit != "1" else axis)
-            ax.set_ylabel(out.rsplit("_", 1)[0].replace("_", " ") + f" ({out.rsplit('_', 1)[1].replace('um', 'µm')})")
+            ax.set_ylabel(out.rsplit("_", 1)[0].replace("_", " ") + f" ({SUMMARY[out].unit.replace('um', 'µm')})")
             ax.grid(alpha=0.3)
         if groups and next(iter(groups)):
             ax_list[0][0].legend(fontsize=7)

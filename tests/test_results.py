@@ -91,7 +91,8 @@ def test_export_writes_csv_with_units_in_the_headers(results_3d, tmp_path):
 # --- figures, checked by what they draw ----------------------------------------------------------------------------
 
 def test_figures_draw_the_datasets_they_claim(results_3d):
-    from fretsim.plotting import centre_row, figures, hertz_profile
+    from fretsim.measures import centre_line as centre_row
+    from fretsim.plotting import figures, hertz_profile
     res = read_results(results_3d)
     figs = figures(res)
     assert set(figs) == {"pressure_profiles", "wear_profiles", "history", "maps"}
@@ -286,7 +287,8 @@ def test_the_layers_keep_their_import_rules():
     for name in ("runner", "sweep", "validate"):
         assert not any(m.startswith("fretsim.api") for m in _imports(MODULES / f"{name}.py")), name
     plotting = {m for m in _imports(MODULES / "plotting.py") if m.startswith("fretsim")}
-    assert plotting == {"fretsim.results"}, plotting  # figures read only the results file
+    # figures read only the results file, measured and named as everything reported is
+    assert plotting == {"fretsim.results", "fretsim.measures", "fretsim.quantities"}, plotting
     for f in MODULES.rglob("*.py"):
         if f.name != "plotting.py":
             assert not any(m.startswith("matplotlib") for m in _imports(f)), f
@@ -390,5 +392,5 @@ def test_plot_overlays_several_runs_and_the_published_values(results_3d, tmp_pat
 
 
 def centre_row_of(res):
-    from fretsim.plotting import centre_row
-    return centre_row(res.fields["wear_depth_stationary"][-1])
+    from fretsim.measures import centre_line
+    return centre_line(res.fields["wear_depth_stationary"][-1])

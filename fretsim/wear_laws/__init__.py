@@ -31,7 +31,9 @@ class WearLaw(Protocol):
         the shear traction q at the increment's end and the slip |ds| over it."""
 
     def gross_slip_factor(self, friction_coefficient: Optional[float]) -> float:
-        """The amount where every point slides (|q| = μp), as a factor of p·|ds|."""
+        """The amount where every point slides (|q| = μp), as a factor of p·|ds| — and its physical bound: since
+        |q| ≤ μp and no point slides further than the rig travels, a cycle's amount summed over the contact never
+        exceeds this factor times P·4δ (the loop checks every cycle against it)."""
 
 
 from fretsim.wear_laws.archard import Archard  # noqa: E402 - the members need the interface above
