@@ -66,10 +66,41 @@ def _spec(key: str) -> Key:
 
 
 def read_measured(path: str | Path) -> Measured:
-    """The measurements: every problem with the file, its column and its row."""
+    """The measurements: every problem with the file, its column and its row.
+
+    Parameters
+    ----------
+    path : a CSV file, ``cycle [cycles]`` and any wear-limit quantities or one profile (``x [mm]`` and a depth),
+        each column with its unit; lines starting with ``#`` are comments.
+
+    Returns
+    -------
+    Measured : one datum per measured cell, in internal units.  A ``CaseError`` lists every problem at once.
+    """
     path = Path(path)
     source = str(path)
+    rows = _csv_rows(path, source)
     problems = []
+    columns = _columns(rows[0], problems)
+    names = [c[0] for c in columns]
+    if "cycle" not in names:
+        problems.append(("header", "no `cycle` column"))
+    profile = "x" in names
+    if profile and not any(n in PROFILES for n in names):
+        problems.append(("header", f"an x column needs a profile column ({', '.join(PROFILES)})"))
+    if problems:
+        raise CaseError(source, problems, "measurements")
+    cyc, keys, vals, xs = _data(rows, columns, profile, problems)
+    if problems:
+        raise CaseError(source, problems[:30], "measurements")
+    if not vals:
+        raise CaseError(source, [("", "no measured values")], "measurements")
+    return Measured(source, np.array(cyc), keys, np.array(vals, float), np.array(xs, float),
+                    {c[0]: c[2] for c in columns if c[0]})
+
+
+def _csv_rows(path: Path, source: str) -> list[list[str]]:
+    """The file's rows without comments: a header and at least one row of data."""
     try:
         with open(path, newline="", encoding="utf-8") as fh:
             rows = list(csv.reader(fh))
@@ -79,8 +110,13 @@ def read_measured(path: str | Path) -> Measured:
     if len(rows) < 2:
         raise CaseError(source, [("", "expected a header like `cycle [cycles],max_wear_depth_stationary [um]` and "
                                       "at least one row")], "measurements")
+    return rows
+
+
+def _columns(header: list[str], problems: list) -> list[tuple]:
+    """(name, kind, unit) of each header cell; (None, None, None) for one that cannot be read (a problem noted)."""
     columns = []
-    for j, text in enumerate(rows[0]):
+    for j, text in enumerate(header):
         m = _HEADER.match(text)
         if not m:
             problems.append((f"column {j + 1}", f"could not read the header {text!r}; expected `name [unit]`"))
@@ -103,14 +139,12 @@ def read_measured(path: str | Path) -> Measured:
             continue
         if name != "cycle" and columns[-1][1] != "fraction" and not unit:
             problems.append((f"column {name}", f"no unit; write e.g. `{name} [um]`"))
+    return columns
+
+
+def _data(rows: list[list[str]], columns: list[tuple], profile: bool, problems: list) -> tuple[list, ...]:
+    """(cycle, key, value, x) of every measured cell below the header, in file order; problems noted per row."""
     names = [c[0] for c in columns]
-    if "cycle" not in names:
-        problems.append(("header", "no `cycle` column"))
-    profile = "x" in names
-    if profile and not any(n in PROFILES for n in names):
-        problems.append(("header", f"an x column needs a profile column ({', '.join(PROFILES)})"))
-    if problems:
-        raise CaseError(source, problems, "measurements")
     cyc, keys, vals, xs = [], [], [], []
     for i, row in enumerate(rows[1:], start=2):
         cells = dict(zip(names, row))
@@ -127,11 +161,7 @@ def read_measured(path: str | Path) -> Measured:
             if name in (None, "cycle") or text.strip() in ("", "nan", "NaN"):
                 continue
             try:
-                if kind == "fraction":
-                    value = float(text.strip().rstrip("%")) / (100.0 if text.strip().endswith("%") or unit == "%"
-                                                                else 1.0)
-                else:
-                    value = parse_quantity(f"{text.strip()} {unit}", kind)
+                value = _cell(text, kind, unit)
             except (UnitError, ValueError) as exc:
                 problems.append((f"row {i}, column {name}", str(exc)))
                 continue
@@ -149,12 +179,14 @@ def read_measured(path: str | Path) -> Measured:
             xs.append(x)
         if profile and not math.isfinite(x):
             problems.append((f"row {i}", "no x for the profile's point"))
-    if problems:
-        raise CaseError(source, problems[:30], "measurements")
-    if not vals:
-        raise CaseError(source, [("", "no measured values")], "measurements")
-    return Measured(source, np.array(cyc), keys, np.array(vals, float), np.array(xs, float),
-                    {c[0]: c[2] for c in columns if c[0]})
+    return cyc, keys, vals, xs
+
+
+def _cell(text: str, kind: str, unit: str) -> float:
+    """One cell in internal units: a fraction as a number or a percentage, anything else with its column's unit."""
+    if kind == "fraction":
+        return float(text.strip().rstrip("%")) / (100.0 if text.strip().endswith("%") or unit == "%" else 1.0)
+    return parse_quantity(f"{text.strip()} {unit}", kind)
 
 
 class _Collect:
@@ -250,9 +282,21 @@ def _start(case: Case, key: str, spec: Key) -> float:
 
 def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overrides=(),
         progress: Optional[Callable[[int], None]] = None) -> FitResult:
-    """Fit ``keys`` of the case to the measurements."""
+    """Fit ``keys`` of the case to the measurements.
+
+    Parameters
+    ----------
+    case_text, source : the case file's text and where it came from (for messages).
+    measured : the measurements, from :func:`read_measured`.
+    keys : dotted case keys of the values to fit, each set in the case (its starting value) and above 0.
+    overrides : ``key=value`` overrides applied to every run.
+    progress : called with the number of runs so far after each run.
+
+    Returns
+    -------
+    FitResult : the values, their 95 % confidence intervals, the residuals and a message.
+    """
     from scipy.optimize import least_squares
-    from scipy.stats import t as student
     keys = tuple(keys)
     specs = [_spec(k) for k in keys]
     cycles = sorted(set(measured.cycles.tolist()))
@@ -264,16 +308,7 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
     if (start <= 0).any():
         raise CaseError(source, [(k, "a fitted value must start above 0") for k, v in zip(keys, start) if v <= 0],
                         "fit")
-    # the grid and the automatic choices fixed once, at the starting values: every run compares like with like
-    from fretsim.plan import prepare
-    _, filled, _ = prepare(parse_case(case_text, source=source, overrides=base))
-    fixed = [f"model.dimension={filled.dimension}", f"grid.domain=[{', '.join(f'{d!r} mm' for d in filled.domain)}]",
-             f"grid.elements=[{', '.join(map(str, filled.elements))}]",
-             f"model.corrections={'none' if not filled.corrections or filled.corrections == 'none' else list(filled.corrections)}",
-             f"model.slip={filled.slip}",
-             # the paper's mid-stroke gap is unstable where the moving body wears too little, which a search over
-             # the coefficients can reach: the stroke-averaged gap is stable for any (unless the case names one)
-             f"model.gap={case0.gap_model if case0.gap_model != 'auto' else 'stroke_average'}"]
+    fixed = _fixed_choices(case_text, source, base, case0)
     runs = [0]
     cache: dict = {}
 
@@ -297,7 +332,38 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
     sol = least_squares(evaluate, x0, bounds=(lo, hi), diff_step=DIFF_STEP, x_scale=1.0, xtol=1e-6, ftol=1e-8,
                         max_nfev=200)
     r = evaluate(sol.x)
-    m, p = r.size, len(keys)
+    low, high, dof, message = _intervals(sol, r, len(keys))
+    at_bound = [k for k, x, a, b in zip(keys, sol.x, lo, hi) if min(x - a, b - x) < 1e-3]
+    if at_bound:
+        message = (f"{', '.join(at_bound)} ended at the edge of the search ({RANGE:g}× from the start): the model "
+                   f"cannot reproduce the data with values in that range (see the residuals); the values are "
+                   f"not a fit" + (f"; {message}" if message else ""))
+    return FitResult(keys, start, np.exp(sol.x), low, high, r, cache[tuple(np.round(sol.x, 12))], measured, runs[0],
+                     dof, message or sol.message, tuple(s.kind for s in specs))
+
+
+def _fixed_choices(case_text: str, source: str, base: list, case0: Case) -> list[str]:
+    """The grid and the automatic choices, fixed once at the starting values: every run compares like with like."""
+    from fretsim.plan import prepare
+    _, filled, _ = prepare(parse_case(case_text, source=source, overrides=base))
+    corrections = "none" if not filled.corrections or filled.corrections == "none" else list(filled.corrections)
+    return [f"model.dimension={filled.dimension}", f"grid.domain=[{', '.join(f'{d!r} mm' for d in filled.domain)}]",
+            f"grid.elements=[{', '.join(map(str, filled.elements))}]",
+            f"model.corrections={corrections}",
+            f"model.slip={filled.slip}",
+            # the paper's mid-stroke gap is unstable where the moving body wears too little, which a search over
+            # the coefficients can reach: the stroke-averaged gap is stable for any (unless the case names one)
+            f"model.gap={case0.gap_model if case0.gap_model != 'auto' else 'stroke_average'}"]
+
+
+def _intervals(sol, r: np.ndarray, p: int) -> tuple[np.ndarray, np.ndarray, int, str]:
+    """The linearised 95 % confidence intervals of the fitted values (Student's t over the degrees of freedom).
+
+    Returns low and high (NaN without degrees of freedom or with a singular Jacobian), the degrees of freedom,
+    and a message saying why there are no intervals ("" when there are).
+    """
+    from scipy.stats import t as student
+    m = r.size
     dof = m - p
     low = high = np.full(p, np.nan)
     if dof > 0:
@@ -313,13 +379,7 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
                                   f"confidence interval (measure more, or fit fewer values)")
     if dof > 0 and not np.isfinite(low).all():
         message = "the data do not determine every value (the Jacobian is singular): fit fewer values"
-    at_bound = [k for k, x, a, b in zip(keys, sol.x, lo, hi) if min(x - a, b - x) < 1e-3]
-    if at_bound:
-        message = (f"{', '.join(at_bound)} ended at the edge of the search ({RANGE:g}× from the start): the model "
-                   f"cannot reproduce the data with values in that range (see the residuals); the values are "
-                   f"not a fit" + (f"; {message}" if message else ""))
-    return FitResult(keys, start, np.exp(sol.x), low, high, r, cache[tuple(np.round(sol.x, 12))], measured, runs[0],
-                     dof, message or sol.message, tuple(s.kind for s in specs))
+    return low, high, dof, message
 
 
 def fitted_case_text(case_text: str, result: FitResult) -> str:

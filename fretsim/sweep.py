@@ -90,35 +90,24 @@ def point_name(values: dict) -> str:
 
 def load_sweep(path: str | Path, progress: Optional[Callable[[int, int], None]] = None) -> Sweep:
     """Read and check a sweep file: every problem with its YAML path, and every point's case validated.
-    ``progress(done, total)`` is called every 1 000 points (10⁵ points take about 15 s)."""
+
+    Parameters
+    ----------
+    path : the sweep file (YAML).
+    progress : ``progress(done, total)`` is called every 1 000 points (10⁵ points take about 15 s).
+
+    Returns
+    -------
+    Sweep : its points named and fingerprinted.  A ``CaseError`` lists every problem at once (the first 50).
+    """
     path = Path(path)
     source = str(path)
-    try:
-        raw = loads(read_text(path, "sweep file"))
-    except (OSError, ValueError) as exc:
-        where = exc.path if isinstance(exc, YamlProblem) else ""
-        raise CaseError(source, [(where, getattr(exc, "message", str(exc)))], "sweep file") from None
-    if not isinstance(raw, dict):
-        raise CaseError(source, [("", "expected a mapping with base, axes (or points), and optionally set and mode")],
-                        "sweep file")
+    raw = _read_sweep(path, source)
     problems = []
     for k in raw:
         if k not in KEYS:
             problems.append((str(k)[:40], f"unknown key; allowed: {', '.join(sorted(KEYS))}"))
-    base = raw.get("base")
-    base_text = base_source = ""
-    if isinstance(base, str):
-        base_path = path.parent / base
-        try:
-            base_text, base_source = read_text(base_path, "base case file"), str(base_path)
-        except (OSError, ValueError) as exc:
-            problems.append(("base", f"{base_path}: {exc}"))
-    elif isinstance(base, dict):
-        import yaml
-        base_text, base_source = yaml.safe_dump(base, sort_keys=False, allow_unicode=True), f"{source}:base"
-    else:
-        problems.append(("base", ("missing" if base is None else f"got {excerpt(base)}")
-                         + "; expected a case file name or an inline case mapping"))
+    base_text, base_source = _base(raw.get("base"), path, source, problems)
     shared = raw.get("set", [])
     if not isinstance(shared, list) or not all(isinstance(s, str) and "=" in s for s in shared):
         problems.append(("set", "expected a list of key.path=value overrides, e.g. [model.dimension=2d]"))
@@ -132,78 +121,136 @@ def load_sweep(path: str | Path, progress: Optional[Callable[[int, int], None]] 
     axes = raw.get("axes", {}) if mode != "points" else {}
     points: list[dict] = []
     if mode in ("product", "zip"):
-        if not isinstance(axes, dict) or not axes:
-            problems.append(("axes", "expected a mapping of case keys to lists of values"))
-            axes = {}
-        for k, vs in axes.items():
-            if not isinstance(k, str) or "." not in k:
-                problems.append((f"axes.{str(k)[:40]}", "expected a dotted case key, e.g. loading.normal_load"))
-            if not isinstance(vs, list) or not vs:
-                problems.append((f"axes.{k}", "expected a non-empty list of values"))
-        good = {k: vs for k, vs in axes.items() if isinstance(vs, list) and vs}
-        if mode == "zip" and len({len(vs) for vs in good.values()}) > 1:
-            problems.append(("axes", f"zip needs lists of one length; got {', '.join(f'{k}: {len(v)}' for k, v in good.items())}"))
-        count = 1
-        for vs in good.values():
-            count *= len(vs)
-        if mode == "product" and count > MAX_POINTS:
-            problems.append(("axes", f"{count} points; at most {MAX_POINTS}"))
-        elif not problems:
-            keys = list(good)
-            combos = product(*good.values()) if mode == "product" else zip(*good.values())
-            points = [dict(zip(keys, c)) for c in combos]
+        axes, points = _grid_points(mode, axes, problems)
     elif mode == "sample":
-        from fretsim import uncertainty
-        spec = raw.get("sample")
-        n = spec.get("n") if isinstance(spec, dict) else None
-        seed = spec.get("seed", 1) if isinstance(spec, dict) else None
-        if not isinstance(spec, dict) or set(spec) - {"n", "seed"} or not isinstance(n, int) or isinstance(n, bool) \
-                or not 1 <= n <= MAX_POINTS or not isinstance(seed, int) or isinstance(seed, bool):
-            problems.append(("sample", f"expected {{n: number of samples (1 to {MAX_POINTS}), seed: a whole number}}, "
-                                       f"got {excerpt(spec)}"))
-            n, seed = 0, 0
-        if not isinstance(axes, dict) or not axes:
-            problems.append(("axes", "expected a mapping of case keys to distributions (or lists of values)"))
-            axes = {}
-        dists, lists = {}, {}
-        for k, v in axes.items():
-            if isinstance(v, list) and v:
-                lists[k] = v
-                continue
-            why = uncertainty.check(v)
-            if why:
-                problems.append((f"axes.{k}", why))
-            else:
-                dists[k] = v
-        if not dists and not problems:
-            problems.append(("axes", "a sampled sweep needs at least one axis that is a distribution"))
-        count = n
-        for vs in lists.values():
-            count *= len(vs)
-        if count > MAX_POINTS:
-            problems.append(("sample", f"{count} points; at most {MAX_POINTS}"))
-        elif not problems:
-            draws = uncertainty.sample(dists, n, seed)
-            points = [{**dict(zip(lists, combo)), **d} for combo in product(*lists.values()) for d in draws]
+        axes, points = _sampled_points(raw.get("sample"), axes, problems)
     elif mode == "points":
-        listed = raw.get("points")
-        if not isinstance(listed, list) or not listed or not all(isinstance(p, dict) and p for p in listed):
-            problems.append(("points", "expected a list of mappings of case keys to values"))
-        elif len(listed) > MAX_POINTS:
-            problems.append(("points", f"{len(listed)} points; at most {MAX_POINTS}"))
-        else:
-            points = listed
+        points = _listed_points(raw.get("points"), problems)
     sweep = Sweep(source, base_text, base_source, tuple(shared), mode, axes if isinstance(axes, dict) else {},
                   sample=raw.get("sample") if mode == "sample" else None)
+    _add_points(sweep, points, progress, problems)
+    if problems:
+        raise CaseError(source, problems[:50] + ([("", f"… and {len(problems) - 50} more")] if len(problems) > 50
+                                                 else []), "sweep file")
+    return sweep
+
+
+def _read_sweep(path: Path, source: str) -> dict:
+    """The sweep file's mapping; a file that cannot be read or is no mapping stops the reading here."""
+    try:
+        raw = loads(read_text(path, "sweep file"))
+    except (OSError, ValueError) as exc:
+        where = exc.path if isinstance(exc, YamlProblem) else ""
+        raise CaseError(source, [(where, getattr(exc, "message", str(exc)))], "sweep file") from None
+    if not isinstance(raw, dict):
+        raise CaseError(source, [("", "expected a mapping with base, axes (or points), and optionally set and mode")],
+                        "sweep file")
+    return raw
+
+
+def _base(base, path: Path, source: str, problems: list) -> tuple[str, str]:
+    """The base case's text and source: a file beside the sweep file, or an inline mapping; ("", "") otherwise."""
+    if isinstance(base, str):
+        base_path = path.parent / base
+        try:
+            return read_text(base_path, "base case file"), str(base_path)
+        except (OSError, ValueError) as exc:
+            problems.append(("base", f"{base_path}: {exc}"))
+    elif isinstance(base, dict):
+        import yaml
+        return yaml.safe_dump(base, sort_keys=False, allow_unicode=True), f"{source}:base"
+    else:
+        problems.append(("base", ("missing" if base is None else f"got {excerpt(base)}")
+                         + "; expected a case file name or an inline case mapping"))
+    return "", ""
+
+
+def _grid_points(mode: str, axes, problems: list) -> tuple[dict, list[dict]]:
+    """Modes product and zip: the checked axes and their points (none while anything in the file is wrong)."""
+    if not isinstance(axes, dict) or not axes:
+        problems.append(("axes", "expected a mapping of case keys to lists of values"))
+        axes = {}
+    for k, vs in axes.items():
+        if not isinstance(k, str) or "." not in k:
+            problems.append((f"axes.{str(k)[:40]}", "expected a dotted case key, e.g. loading.normal_load"))
+        if not isinstance(vs, list) or not vs:
+            problems.append((f"axes.{k}", "expected a non-empty list of values"))
+    good = {k: vs for k, vs in axes.items() if isinstance(vs, list) and vs}
+    if mode == "zip" and len({len(vs) for vs in good.values()}) > 1:
+        lengths = ", ".join(f"{k}: {len(v)}" for k, v in good.items())
+        problems.append(("axes", f"zip needs lists of one length; got {lengths}"))
+    count = 1
+    for vs in good.values():
+        count *= len(vs)
+    if mode == "product" and count > MAX_POINTS:
+        problems.append(("axes", f"{count} points; at most {MAX_POINTS}"))
+    elif not problems:
+        keys = list(good)
+        combos = product(*good.values()) if mode == "product" else zip(*good.values())
+        return axes, [dict(zip(keys, c)) for c in combos]
+    return axes, []
+
+
+def _sampled_points(spec, axes, problems: list) -> tuple[dict, list[dict]]:
+    """Mode sample: ``spec`` {n, seed} draws of the distributed axes for each combination of the listed ones
+    (none while anything in the file is wrong)."""
+    from fretsim import uncertainty
+    n = spec.get("n") if isinstance(spec, dict) else None
+    seed = spec.get("seed", 1) if isinstance(spec, dict) else None
+    if not isinstance(spec, dict) or set(spec) - {"n", "seed"} or not isinstance(n, int) or isinstance(n, bool) \
+            or not 1 <= n <= MAX_POINTS or not isinstance(seed, int) or isinstance(seed, bool):
+        problems.append(("sample", f"expected {{n: number of samples (1 to {MAX_POINTS}), seed: a whole number}}, "
+                                   f"got {excerpt(spec)}"))
+        n, seed = 0, 0
+    if not isinstance(axes, dict) or not axes:
+        problems.append(("axes", "expected a mapping of case keys to distributions (or lists of values)"))
+        axes = {}
+    dists, lists = {}, {}
+    for k, v in axes.items():
+        if isinstance(v, list) and v:
+            lists[k] = v
+            continue
+        why = uncertainty.check(v)
+        if why:
+            problems.append((f"axes.{k}", why))
+        else:
+            dists[k] = v
+    if not dists and not problems:
+        problems.append(("axes", "a sampled sweep needs at least one axis that is a distribution"))
+    count = n
+    for vs in lists.values():
+        count *= len(vs)
+    if count > MAX_POINTS:
+        problems.append(("sample", f"{count} points; at most {MAX_POINTS}"))
+    elif not problems:
+        draws = uncertainty.sample(dists, n, seed)
+        return axes, [{**dict(zip(lists, combo)), **d} for combo in product(*lists.values()) for d in draws]
+    return axes, []
+
+
+def _listed_points(listed, problems: list) -> list[dict]:
+    """Mode points: the file's own list of points."""
+    if not isinstance(listed, list) or not listed or not all(isinstance(p, dict) and p for p in listed):
+        problems.append(("points", "expected a list of mappings of case keys to values"))
+    elif len(listed) > MAX_POINTS:
+        problems.append(("points", f"{len(listed)} points; at most {MAX_POINTS}"))
+    else:
+        return listed
+    return []
+
+
+def _add_points(sweep: Sweep, points: list[dict], progress, problems: list) -> None:
+    """Each point's case validated, named and fingerprinted into ``sweep.points``; its problems under its label."""
     names = set()
     for i, values in enumerate(points):
         if progress is not None and i % 1000 == 0 and len(points) > 1000:
             progress(i, len(points))
         overrides = tuple(f"{k}={_text(v)}" for k, v in values.items())
         try:
-            case = parse_case(base_text, source=base_source, overrides=[*shared, *overrides])
+            case = parse_case(sweep.base_text, source=sweep.base_source, overrides=[*sweep.shared, *overrides])
         except CaseError as exc:
-            label = f"points[{i}]" if mode == "points" else f"point {', '.join(f'{k}={_text(v)}' for k, v in values.items())}"
+            label = (f"points[{i}]" if sweep.mode == "points" else
+                     f"point {', '.join(f'{k}={_text(v)}' for k, v in values.items())}")
             problems += [(f"{label}: {p}" if p else label, m) for p, m in exc.problems]
             continue
         name = point_name(values)
@@ -211,10 +258,6 @@ def load_sweep(path: str | Path, progress: Optional[Callable[[int, int], None]] 
             problems.append((f"points[{i}]", f"the same values as an earlier point ({name})"))
         names.add(name)
         sweep.points.append(Point(name, overrides, dict(values), case.fingerprint()))
-    if problems:
-        raise CaseError(source, problems[:50] + ([("", f"… and {len(problems) - 50} more")] if len(problems) > 50
-                                                 else []), "sweep file")
-    return sweep
 
 
 # --- running the points ------------------------------------------------------------------------------------------

@@ -57,70 +57,34 @@ def solve_cg(compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] 
     ContactResult : pressure, approach α, contact set, iterations, ``success`` and a message; never raises on
         non-convergence (the caller decides).
     """
-    area = compliance.grid.area
-    total = load / area  # required Σp
+    total = load / compliance.grid.area  # required Σp
     allowed = np.isfinite(gap)
     h = np.where(allowed, gap, 0.0)
     max_iter = max_iter or max(1000, 5 * int(np.sqrt(gap.size)) + 200)
     precond = _preconditioner(compliance) if precondition else None
-
-    if p0 is not None and (p0[allowed] > 0).any():
-        p = np.where(allowed, np.clip(p0, 0.0, None), 0.0)
-    else:
-        # a uniform start on the region nearest to contact keeps the first steps physical
-        hmin = h[allowed].min()
-        near = allowed & (h <= hmin + 0.5 * (np.percentile(h[allowed], 10) - hmin) + 1e-300)
-        p = near.astype(float)
-    p *= total / p.sum()
-
+    p = _start(p0, h, allowed, total)
     t = np.zeros_like(p)
-    gz_old = 1.0
-    delta = 0.0
-    err = np.inf
+    gz_old, delta, err = 1.0, 0.0, np.inf
     u = compliance(p)
     complementary = False
     for it in range(1, max_iter + 1):
-        on = p > 0
-        m = on.astype(float)
-        count = float(m.sum())
-        g = u + h
-        g -= float((g * m).sum()) / count
-        if precond is not None:
-            z = precond(g * m) * m
-            z -= m * (float(z.sum()) / count)
-        else:
-            z = g * m
-        gz = float((g * z).sum())
-        t = z + (delta * gz / gz_old) * t if delta else z
-        t *= m
+        on, m, count, g = _gradient(u, h, p)
+        t, gz = _direction(g, m, count, precond, t, delta, gz_old)
         gz_old = gz
         r_raw = compliance(t)
-        r_mean = float((r_raw * m).sum()) / count
-        denom = float((r_raw * t).sum()) - r_mean * float(t.sum())
+        denom = _curvature(r_raw, t, m, count)
         penetrating = (~on) & allowed & (g < 0.0)
         if denom <= 0.0 or gz == 0.0:
             # nothing left to do on this set: converged if nothing outside it penetrates
             if not penetrating.any():
                 err, complementary = 0.0, True
                 break
-            p[penetrating] = -g[penetrating] * (total / max(float(np.abs(g[penetrating]).sum()), 1e-300))
-            p *= total / p.sum()
+            p = _admit(p, g, penetrating, total)
             u, delta = compliance(p), 0.0
             continue
-        tau = float((g * t).sum()) / denom
         p_old = p
-        for _ in range(60):
-            trial = p_old - tau * t
-            clipped = bool((trial < 0.0).any())
-            p = np.clip(trial, 0.0, None)
-            if penetrating.any():
-                p[penetrating] -= tau * g[penetrating]
-            if p.sum() > 0.0:
-                break
-            tau *= 0.5  # the step lifted every element off (a rough gap, a poor warm start): a shorter one
+        p, tau, clipped, scale = _step(p_old, float((g * t).sum()) / denom, t, g, penetrating, total)
         delta = 0.0 if penetrating.any() else 1.0
-        scale = total / p.sum()
-        p *= scale
         # Without clipping or added elements p is linear in t, and so is u: one FFT per iteration instead of
         # two.  Otherwise (an element may be clipped and re-added in one step, leaving the set unchanged but p
         # not linear in t), and every RECOMPUTE_EVERY-th step against round-off, u is recomputed exactly.
@@ -135,6 +99,89 @@ def solve_cg(compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] 
             complementary = _complementary(u, h, p, allowed)
             if complementary:
                 break
+    return _result(compliance, p, h, gap, allowed, it, err, tol, complementary)
+
+
+def _start(p0: Optional[np.ndarray], h: np.ndarray, allowed: np.ndarray, total: float) -> np.ndarray:
+    """The first pressure, Σp = total: the warm start clipped to p ≥ 0, or uniform near the closest points."""
+    if p0 is not None and (p0[allowed] > 0).any():
+        p = np.where(allowed, np.clip(p0, 0.0, None), 0.0)
+    else:
+        # a uniform start on the region nearest to contact keeps the first steps physical
+        hmin = h[allowed].min()
+        near = allowed & (h <= hmin + 0.5 * (np.percentile(h[allowed], 10) - hmin) + 1e-300)
+        p = near.astype(float)
+    p *= total / p.sum()
+    return p
+
+
+def _gradient(u: np.ndarray, h: np.ndarray, p: np.ndarray):
+    """The contact set (mask, 0/1 weights, size) and the gap u + h less its mean over that set.
+
+    The mean is the approach α of the current pressure, so g is the separation the step drives to zero.
+    """
+    on = p > 0
+    m = on.astype(float)
+    count = float(m.sum())
+    g = u + h
+    g -= float((g * m).sum()) / count
+    return on, m, count, g
+
+
+def _direction(g: np.ndarray, m: np.ndarray, count: float, precond, t: np.ndarray, delta: float,
+               gz_old: float) -> tuple[np.ndarray, float]:
+    """The next search direction on the contact set, conjugate to the last unless ``delta`` is 0, and ⟨g, z⟩.
+
+    The preconditioned residual is projected onto zero-mean changes, so a step keeps Σp (the load).
+    """
+    if precond is not None:
+        z = precond(g * m) * m
+        z -= m * (float(z.sum()) / count)
+    else:
+        z = g * m
+    gz = float((g * z).sum())
+    t = z + (delta * gz / gz_old) * t if delta else z
+    t *= m
+    return t, gz
+
+
+def _curvature(r_raw: np.ndarray, t: np.ndarray, m: np.ndarray, count: float) -> float:
+    """tᵀ(C t − mean over the contact set): the energy's curvature along t at fixed load."""
+    r_mean = float((r_raw * m).sum()) / count
+    return float((r_raw * t).sum()) - r_mean * float(t.sum())
+
+
+def _admit(p: np.ndarray, g: np.ndarray, penetrating: np.ndarray, total: float) -> np.ndarray:
+    """Pressure put on the penetrating elements, in proportion to their penetration, then back to the load."""
+    p = p.copy()
+    p[penetrating] = -g[penetrating] * (total / max(float(np.abs(g[penetrating]).sum()), 1e-300))
+    p *= total / p.sum()
+    return p
+
+
+def _step(p_old: np.ndarray, tau: float, t: np.ndarray, g: np.ndarray, penetrating: np.ndarray, total: float):
+    """The step p − τt clipped to p ≥ 0, penetrating elements added, rescaled to the load.
+
+    Returns the new pressure, the step length taken (halved while the step lifted every element off), whether
+    any element was clipped, and the load's rescaling factor.
+    """
+    for _ in range(60):
+        trial = p_old - tau * t
+        clipped = bool((trial < 0.0).any())
+        p = np.clip(trial, 0.0, None)
+        if penetrating.any():
+            p[penetrating] -= tau * g[penetrating]
+        if p.sum() > 0.0:
+            break
+        tau *= 0.5  # the step lifted every element off (a rough gap, a poor warm start): a shorter one
+    scale = total / p.sum()
+    p *= scale
+    return p, tau, clipped, scale
+
+
+def _result(compliance, p: np.ndarray, h: np.ndarray, gap: np.ndarray, allowed: np.ndarray, it: int, err: float,
+            tol: float, complementary: bool) -> ContactResult:
+    """The last iterate's record: approach and residual from an exact C p, and the stopping rule's verdict."""
     u = compliance(p)
     on = p > 0
     approach = float((u + h)[on].mean())

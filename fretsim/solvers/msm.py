@@ -67,71 +67,78 @@ def solve_msm(compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray]
     total = load / compliance.grid.area
     max_iter = max_iter or 4 * n + 10
     lp = _Basis(C, eps, total)
-
-    # the free variable α enters first
-    lp.pivot(("alpha", -1), lp.ratio_test(lp.direction(("alpha", -1)), None))
-    pivots = 1
-    last_left = None
-    success, message = False, ""
-    while pivots < max_iter:
-        if not lp.z_basic or lp.z_value() <= 1e-14 * total:
-            success = True  # Σ Z = 0: the basis is complementary and feasible
-            break
-        entering = leaving = None
-        y_t = lp.dual()
-        rc_tol = 1e-12 * (float(np.abs(y_t).max()) * float(C[0, 0]) + 1.0)
-        # 1) unrestricted candidates: elements with both p and Y non-basic
-        for rc, q in sorted(lp.free_pair_prices(y_t)):
-            if rc >= -rc_tol:
-                break
-            leaving = lp.ratio_test(lp.direction(q), None)
-            if leaving is not None:
-                entering = q
-                break
-        # 2) restricted candidates: only if their basic complement leaves in this pivot
-        if entering is None:
-            for rc, q in sorted(lp.restricted_prices(y_t))[:50]:
-                if rc >= -rc_tol:
-                    break
-                comp = _complement(q)
-                leaving = lp.ratio_test(lp.direction(q), comp)
-                if leaving == comp:
-                    entering = q
-                    break
-        # 3) degenerate complementary step
-        if entering is None and last_left is not None and _complement(last_left) is not None \
-                and not lp.is_basic(_complement(last_left)):
-            q = _complement(last_left)
-            leaving = lp.ratio_test(lp.direction(q), None)
-            entering = q if leaving is not None else None
-        if entering is None:
-            message = f"msm: no admissible entering variable with Z = {lp.z_value():.3e} > 0 after {pivots} pivots"
-            break
-        last_left = leaving
-        lp.pivot(entering, leaving)
-        pivots += 1
-    else:
-        message = f"msm: no solution within {max_iter} pivots"
-
-    p = np.zeros(n)
-    approach = 0.0
+    success, message, pivots = _pivot_to_solution(lp, C, total, max_iter)
+    p, approach = np.zeros(n), 0.0
     if success:
-        x_n = lp.solve_basic()
-        for (kind, j), v in zip(lp.nonslack, x_n):
-            if kind == "F":
-                p[j] = v
-            elif kind == "alpha":
-                approach = float(v) + shift
-        if (p < -1e-9 * total).any():
-            success = False
-            message = f"msm: the final basis has negative pressure {p.min():.3e}"
-        np.clip(p, 0.0, None, out=p)
-        message = message or f"msm converged in {pivots} pivots"
+        p, approach, success, message = _solution(lp, n, shift, total, pivots)
     full = np.zeros(gap.size)
     full[idx] = p
     pressure = full.reshape(shape)
     residual = complementarity_residual(compliance(pressure), gap, pressure, approach) if success else float("nan")
     return ContactResult(pressure, approach, pressure > 0, pivots, success, message, residual)
+
+
+def _pivot_to_solution(lp: "_Basis", C: np.ndarray, total: float, max_iter: int) -> tuple[bool, str, int]:
+    """Pivot until Σ Z = 0 (success), no variable may enter, or ``max_iter`` pivots: (success, message, pivots)."""
+    # the free variable α enters first
+    lp.pivot(("alpha", -1), lp.ratio_test(lp.direction(("alpha", -1)), None))
+    pivots = 1
+    last_left = None
+    while pivots < max_iter:
+        if not lp.z_basic or lp.z_value() <= 1e-14 * total:
+            return True, "", pivots  # Σ Z = 0: the basis is complementary and feasible
+        entering, leaving = _entering(lp, C, last_left)
+        if entering is None:
+            z = lp.z_value()
+            return False, f"msm: no admissible entering variable with Z = {z:.3e} > 0 after {pivots} pivots", pivots
+        last_left = leaving
+        lp.pivot(entering, leaving)
+        pivots += 1
+    return False, f"msm: no solution within {max_iter} pivots", pivots
+
+
+def _entering(lp: "_Basis", C: np.ndarray, last_left):
+    """The restricted-basis entry rule: (entering, leaving) variables of the next pivot, or (None, None)."""
+    y_t = lp.dual()
+    rc_tol = 1e-12 * (float(np.abs(y_t).max()) * float(C[0, 0]) + 1.0)
+    # 1) unrestricted candidates: elements with both p and Y non-basic
+    for rc, q in sorted(lp.free_pair_prices(y_t)):
+        if rc >= -rc_tol:
+            break
+        leaving = lp.ratio_test(lp.direction(q), None)
+        if leaving is not None:
+            return q, leaving
+    # 2) restricted candidates: only if their basic complement leaves in this pivot
+    for rc, q in sorted(lp.restricted_prices(y_t))[:50]:
+        if rc >= -rc_tol:
+            break
+        comp = _complement(q)
+        leaving = lp.ratio_test(lp.direction(q), comp)
+        if leaving == comp:
+            return q, leaving
+    # 3) degenerate complementary step
+    if last_left is not None and _complement(last_left) is not None and not lp.is_basic(_complement(last_left)):
+        q = _complement(last_left)
+        leaving = lp.ratio_test(lp.direction(q), None)
+        if leaving is not None:
+            return q, leaving
+    return None, None
+
+
+def _solution(lp: "_Basis", n: int, shift: float, total: float, pivots: int) -> tuple[np.ndarray, float, bool, str]:
+    """The pressures and approach of the final basis: (p, α, success, message); a negative pressure fails."""
+    p = np.zeros(n)
+    approach = 0.0
+    for (kind, j), v in zip(lp.nonslack, lp.solve_basic()):
+        if kind == "F":
+            p[j] = v
+        elif kind == "alpha":
+            approach = float(v) + shift
+    success, message = True, f"msm converged in {pivots} pivots"
+    if (p < -1e-9 * total).any():
+        success, message = False, f"msm: the final basis has negative pressure {p.min():.3e}"
+    np.clip(p, 0.0, None, out=p)
+    return p, approach, success, message
 
 
 def _complement(var):

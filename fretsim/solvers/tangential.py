@@ -70,14 +70,19 @@ def solve_tangential(compliance, rhs: np.ndarray, bound: np.ndarray, q0: Optiona
     if scale_q <= 0:
         zero = np.zeros_like(rhs)
         return TangentialResult(zero, np.zeros_like(rhs), np.zeros(rhs.shape, bool), 0, True, "no contact")
-    precond = _preconditioner(compliance)
     q = np.zeros_like(rhs) if q0 is None else np.clip(np.where(allowed, q0, 0.0), lo, hi)
+    return _iterate(compliance, rhs, lo, hi, allowed, scale_q, q, tol, max_iter)
+
+
+def _iterate(compliance, rhs: np.ndarray, lo: np.ndarray, hi: np.ndarray, allowed: np.ndarray, scale_q: float,
+             q: np.ndarray, tol: float, max_iter: int) -> TangentialResult:
+    """Constrained CG from the start ``q``: proportioning where a slip reversed, conjugate steps on the stuck set."""
+    precond = _preconditioner(compliance)
     u = compliance(q)
     disp_scale = max(float(np.abs(rhs[allowed]).max()), float(np.abs(u[allowed]).max()), 1e-300)
     t = np.zeros_like(q)
     gz_old, delta, err = 1.0, 0.0, np.inf
     it = 0
-    ok = False
     for it in range(1, max_iter + 1):
         g = u - rhs
         at_lo, at_hi = allowed & (q <= lo), allowed & (q >= hi)
@@ -85,40 +90,24 @@ def solve_tangential(compliance, rhs: np.ndarray, bound: np.ndarray, q0: Optiona
         release = (at_lo & (g < 0)) | (at_hi & (g > 0))  # a slipping element whose slip has reversed
         q_old = q
         if release.any():
-            # proportioning: the released elements move inwards along their gradient by the exact line search
-            # of the quadratic, then stick or reach the other bound; conjugacy restarts after
-            d = np.where(release, g, 0.0)
-            r = compliance(d)
-            curvature = float((d * r).sum())
-            if curvature <= 0.0:
-                return _result(q, u, rhs, allowed, lo, hi, disp_scale, it, False,
-                               f"tangential: the compliance is not positive definite here (curvature {curvature:.2e})")
-            q = np.clip(q - float((d * g).sum()) / curvature * d, lo, hi)
+            q, curvature = _release(compliance, q, g, release, lo, hi)
+            if q is None:
+                return _result(q_old, u, rhs, allowed, lo, hi, disp_scale, it, False, _not_definite(curvature))
             u, delta = compliance(q), 0.0
             err = float(np.abs(q - q_old).sum()) / scale_q
             continue
-        if not free.any():
-            err = 0.0  # every element slips the way its gradient says: optimal
-            ok = True
-            break
-        m = free.astype(float)
-        z = precond(g * m) * m if precond is not None else g * m
-        gz = float((g * z).sum())
-        t = (z + (delta * gz / gz_old) * t if delta and gz_old else z) * m
+        if not free.any():  # every element slips the way its gradient says: optimal
+            return _finish(compliance, q, rhs, allowed, lo, hi, disp_scale, it, True, 0.0, tol)
+        t, gz = _direction(g, free, precond, t, delta, gz_old)
         gz_old = gz
         r = compliance(t)
         denom = float((r * t).sum())
         if denom <= 0.0:
-            if gz == 0.0:  # the stuck set is already exact
-                err = 0.0
-            else:
-                return _result(q, u, rhs, allowed, lo, hi, disp_scale, it, False,
-                               f"tangential: the compliance is not positive definite here (curvature {denom:.2e})")
+            if gz != 0.0:
+                return _result(q, u, rhs, allowed, lo, hi, disp_scale, it, False, _not_definite(denom))
+            err = 0.0  # the stuck set is already exact
         else:
-            tau = float((g * t).sum()) / denom
-            trial = q - tau * t
-            clipped = bool(((trial < lo) | (trial > hi))[free].any())
-            q = np.clip(trial, lo, hi)  # an element that overshoots its bound starts to slip
+            q, tau, clipped = _step(q, t, g, denom, free, lo, hi)
             delta = 0.0 if clipped else 1.0
             u = compliance(q) if clipped or it % RECOMPUTE_EVERY == 0 else u - tau * r
             err = float(np.abs(q - q_old).sum()) / scale_q
@@ -126,13 +115,54 @@ def solve_tangential(compliance, rhs: np.ndarray, bound: np.ndarray, q0: Optiona
             return _result(q_old, compliance(q_old), rhs, allowed, lo, hi, disp_scale, it, False,
                            f"tangential: non-finite traction at iteration {it}")
         if err < tol and _kkt(q, u - rhs, allowed, lo, hi) <= SLIP_TOLERANCE * disp_scale:
-            ok = True
-            break
+            return _finish(compliance, q, rhs, allowed, lo, hi, disp_scale, it, True, err, tol)
+    return _finish(compliance, q, rhs, allowed, lo, hi, disp_scale, it, False, err, tol)
+
+
+def _finish(compliance, q, rhs, allowed, lo, hi, disp_scale, it, ok, err, tol) -> TangentialResult:
+    """The record of the last iterate, its slip from an exact K q, and the stopping rule's verdict."""
     u = compliance(q)
     msg = (f"tangential converged in {it} iterations" if ok else
            f"tangential did not converge in {it} iterations: relative traction change {err:.1e} (tolerance "
            f"{tol:.0e}), optimality residual {_kkt(q, u - rhs, allowed, lo, hi) / disp_scale:.1e}")
     return _result(q, u, rhs, allowed, lo, hi, disp_scale, it, ok, msg)
+
+
+def _release(compliance, q: np.ndarray, g: np.ndarray, release: np.ndarray, lo: np.ndarray, hi: np.ndarray):
+    """Proportioning: the released elements move inwards along their gradient by the exact line search of the
+    quadratic, then stick or reach the other bound (conjugacy restarts after).
+
+    Returns the new traction (None where the curvature along the gradient is not positive) and that curvature.
+    """
+    d = np.where(release, g, 0.0)
+    r = compliance(d)
+    curvature = float((d * r).sum())
+    if curvature <= 0.0:
+        return None, curvature
+    return np.clip(q - float((d * g).sum()) / curvature * d, lo, hi), curvature
+
+
+def _direction(g: np.ndarray, free: np.ndarray, precond, t: np.ndarray, delta: float,
+               gz_old: float) -> tuple[np.ndarray, float]:
+    """The preconditioned direction on the stuck set, conjugate to the last unless ``delta`` is 0, and ⟨g, z⟩."""
+    m = free.astype(float)
+    z = precond(g * m) * m if precond is not None else g * m
+    gz = float((g * z).sum())
+    return (z + (delta * gz / gz_old) * t if delta and gz_old else z) * m, gz
+
+
+def _step(q: np.ndarray, t: np.ndarray, g: np.ndarray, denom: float, free: np.ndarray, lo: np.ndarray,
+          hi: np.ndarray) -> tuple[np.ndarray, float, bool]:
+    """The exact line-search step along t, clipped to the box: (traction, step length, whether a stuck element
+    overshot its bound)."""
+    tau = float((g * t).sum()) / denom
+    trial = q - tau * t
+    clipped = bool(((trial < lo) | (trial > hi))[free].any())
+    return np.clip(trial, lo, hi), tau, clipped  # an element that overshoots its bound starts to slip
+
+
+def _not_definite(curvature: float) -> str:
+    return f"tangential: the compliance is not positive definite here (curvature {curvature:.2e})"
 
 
 def _kkt(q, g, allowed, lo, hi) -> float:
