@@ -29,18 +29,17 @@ from typing import Optional
 import numpy as np
 
 from fretsim.case import CaseError, load_case
+from fretsim.quantities import WEAR
 from fretsim.units import UnitError, parse_quantity
 
 CASES = Path(__file__).resolve().parent / "cases"
-QUANTITIES = {  # expected key: (summary key or None, unit in the report, scale from mm)
-    "centre_wear_depth_stationary": ("centre_wear_depth_stationary_um", "µm", 1e3),
-    "max_wear_depth_stationary": ("max_wear_depth_stationary_um", "µm", 1e3),
-    "max_wear_depth_moving": ("max_wear_depth_moving_um", "µm", 1e3),
-    "scar_width_stationary": ("scar_width_stationary_mm", "mm", 1.0),
-    "scar_width_moving": ("scar_width_moving_mm", "mm", 1.0),
-    "contact_half_width": (None, "mm", 1.0),
-    "element_size_x": ("element_size_x_um", "µm", 1e3),
-}
+# expected key: (summary key or None, unit in the report, scale from mm): the wear quantities published values are
+# given for (fretsim.quantities), the unworn contact's half-width and the element
+QUANTITIES = {**{key: (WEAR[key].summary_key, WEAR[key].unit.replace("um", "µm"), WEAR[key].factor)
+                 for key in ("centre_wear_depth_stationary", "max_wear_depth_stationary", "max_wear_depth_moving",
+                             "scar_width_stationary", "scar_width_moving")},
+              "contact_half_width": (None, "mm", 1.0),
+              "element_size_x": ("element_size_x_um", "µm", 1e3)}
 GROUPS = ("experiment", "fea", "paper")
 # Kong et al. Table 3: simulation times of the paper's method (the FEA and BEM beside it)
 TABLE3 = [("2D cylinder on flat, 18 000 cycles", "mccoll_185N", ["model.dimension=2d"], "36 s (FEA [18]: 1 day, "
