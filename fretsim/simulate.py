@@ -152,6 +152,7 @@ class _Loop:
         self.block, self.block_start = 0, 0  # the block whose cycle model gives the current rates, and its start
         self.work_bound = 0.0  # the largest wear work the blocks before the current one allow (N·mm)
         self.landing = Landing()
+        self.reached: Optional[tuple] = None  # the wear limit the run ended at (Step.limit), once it has
         self.last_state: Optional[dict] = None
         self.h_m = np.zeros(setup.grid.shape)
         self.h_s = np.zeros(setup.grid.shape)
@@ -238,7 +239,7 @@ class _Loop:
             return None
         if verdict == "reached":
             step.is_snapshot = True  # the state at the limit is what the engineer looks at
-            step.limit = self.landing.reached()
+            step.limit = self.reached = self.landing.reached()
         step.state = checkpoint.state(self)
         self.last_state = step.state
         for obs in self.observers:
@@ -262,6 +263,7 @@ class _Loop:
         self.cyc = self.cyc or self.restored_cycle()
         step = _record(self.s, self.n, self.h_m, self.h_s, self.cyc, self.work, self.t0 - self.elapsed)
         step.error_depth = max(_rel_scalar(self.err_abs_m, self.h_m), _rel_scalar(self.err_abs_s, self.h_s))
+        step.block, step.limit, step.is_snapshot = self.block, self.reached, step.is_snapshot or bool(self.reached)
         step.state = checkpoint.state(self)
         return step
 
@@ -300,7 +302,7 @@ class _Loop:
             step = self.emit(cyc, 0)
         else:
             self.restore(resume)
-            if self.n >= s.cycles:  # killed as it finished: the state is the last step
+            if self.n >= s.cycles or self.reached is not None:  # killed as it finished: the state is the last step
                 return self.current_step()
         if s.cycles == 0 or self.n >= s.cycles:
             return step

@@ -34,6 +34,8 @@ def state(loop) -> dict:
         st["track_n"] = np.array([t[0] for t in loop.landing.track], dtype=float)
         for key in loop.s.wear_limits:
             st["track_" + key] = np.array([t[1][key] for t in loop.landing.track], dtype=float)
+    if loop.reached is not None:  # the run ended at a wear limit: a resume must not step past it
+        st["limit_key"], st["limit_cycle"], st["limit_spread"], st["limit_exponent"] = loop.reached
     for k, v in loop.memory.items():
         st["memory_" + k] = v
     return st
@@ -56,6 +58,8 @@ def restore(loop, st: dict) -> None:
     if loop.s.block_cycles:
         loop.model = loop.s.block_cycles[loop.block]
     loop.landing.retakes = int(st.get("retakes", loop.landing.retakes))
+    loop.reached = ((str(st["limit_key"]), float(st["limit_cycle"]), float(st["limit_spread"]),
+                     float(st["limit_exponent"])) if "limit_key" in st else None)
     loop.last_state = st  # a checkpoint is the state of the step written last: a retake goes back to it
     _restore_limits(loop, st)
     _restore_memory(loop, st)

@@ -16,6 +16,7 @@ from typing import Any, Callable, Optional
 from fretsim.simulate import simulate
 
 CACHE_SIZE = 64  # proxies (or pilots) kept; beyond, the cache starts afresh
+_MISSING = object()
 
 
 @dataclass
@@ -39,9 +40,11 @@ class SideRuns:
 
     def remembered(self, cache: dict, key: str, compute: Callable[[], Any]) -> Any:
         """``cache[key]``, computed once."""
-        if key not in cache:
-            value = compute()
-            if len(cache) > CACHE_SIZE:
-                cache.clear()
-            cache[key] = value
-        return cache[key]
+        value = cache.get(key, _MISSING)  # one lookup: another thread may clear the cache between two
+        if value is not _MISSING:
+            return value
+        value = compute()
+        if len(cache) > CACHE_SIZE:
+            cache.clear()
+        cache[key] = value
+        return value  # not cache[key]: a worker's other thread may have cleared the cache meanwhile
