@@ -35,10 +35,12 @@ LAWS = {"archard": [],
         "energy": ["model.wear_law=energy", "materials.moving.energy_wear_coefficient=2.2e-5 mm3/J",
                    "materials.stationary.energy_wear_coefficient=3.3e-5 mm3/J"]}
 ROUND_OFF = 1e-9  # the worn volume against its invariant: both are sums of the same increments
-# the schemes against the per-cycle model, depths: the default jumping.tolerance is 1 % for the implicit schemes,
-# and the explicit ones at half the stability limit were measured within 0.8 % here.  A resolved stroke's depths
-# move with the step by a few per cent (its kinks: README, "the resolved stroke"; measured up to 1.6 % at 200 cycles)
-TO_PER_CYCLE = {False: 0.01, True: 0.03}
+# the schemes against the per-cycle model, depths.  The implicit schemes hold their own estimate of the depth error
+# to DEPTH_SHARE (7 %) of jumping.tolerance (1 %), but on a run this short it under-covers: measured 0.08-0.28 %
+# here (BDF2, backward Euler), so 0.5 %; the explicit ones at half the stability limit were measured within 0.8 %
+# (their error is ½(ΔN − 1)·ΔN·ṙ, not controlled), so 1 %.  A resolved stroke's depths move with the step by a
+# few per cent (its kinks: README, "the resolved stroke"; measured up to 1.6 % at 200 cycles), so 3 %.
+TO_PER_CYCLE = {(False, True): 0.005, (False, False): 0.01, (True, True): 0.03, (True, False): 0.03}
 
 
 def _base(cycles: int) -> list:
@@ -127,7 +129,8 @@ def test_each_member_law_and_scheme_keeps_its_invariant_its_bound_and_the_per_cy
             own = cyc.energy if combo.law == "energy" else float((cyc.pressure * cyc.slip_moving).sum()) * area
             assert cyc.work == pytest.approx(own, rel=ROUND_OFF)
     for key in ("max_wear_depth_stationary_um", "max_wear_depth_moving_um"):
-        assert out.summary[key] == pytest.approx(reference.summary[key], rel=TO_PER_CYCLE[resolved]), key
+        tolerance = TO_PER_CYCLE[resolved, SCHEMES[combo.scheme].implicit]
+        assert out.summary[key] == pytest.approx(reference.summary[key], rel=tolerance), key
 
 
 # --- a member registered by a test alone ----------------------------------------------------------------------------

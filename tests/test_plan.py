@@ -7,6 +7,7 @@ from pathlib import Path
 
 import pytest
 
+from fretsim.api import run
 from fretsim.case import CaseError, load_case
 from fretsim.plan import SideRuns, cost, cycle, grid, inputs, model, prepare, stepping
 from fretsim.plan.choices import Plan
@@ -155,13 +156,20 @@ def test_a_historys_stability_limit_is_its_most_restrictive_blocks():
 
 # --- cost ---------------------------------------------------------------------------------------------------------
 
-def test_the_solves_estimate_follows_each_scheme():
-    for scheme, expected in (("linear", lambda s: s.cycles // s.linear_jump + len(s.snapshots) + 1),
-                             ("bdf2", lambda s: min(s.cycles + 1, int(10 + 12 * math.log10(s.cycles)
-                                                                      + 7 * len(s.snapshots))))):
-        setup, _, _ = prepare(_case(f"jumping.scheme={scheme}"))
-        assert cost.estimate_solves(setup) == expected(setup), scheme
-    assert cost.estimate_solves(prepare(_case("loading.cycles=0"))[0]) == 1
+@pytest.mark.parametrize("scheme", [
+    "bdf2", "implicit", "linear",
+    pytest.param("adaptive", marks=pytest.mark.xfail(strict=True, reason="measured 7-9× more solves than estimated on "
+                                                                         "the accuracy grid (ΔN_L 5): the estimate "
+                                                                         "assumes the paper's coarser grid")),
+])
+def test_the_solves_estimate_is_within_a_factor_two_of_the_run(scheme):
+    # what `check` and the progress bar promise: measured 0.61-0.74 (BDF2), 1.4-1.5 (backward Euler), 1.0 (linear)
+    for cycles in (2000, 18000):
+        out = run(load_case(MCCOLL, [*TWO_D, f"loading.cycles={cycles}", "grid.error_estimate=none",
+                                     f"jumping.scheme={scheme}"]))
+        ratio = out.summary["contact_solves"] / cost.estimate_solves(out.setup)
+        assert 0.5 <= ratio <= 2.0, (cycles, ratio)
+    assert cost.estimate_solves(prepare(_case("loading.cycles=0"))[0]) == 1  # the contact alone: one solve
 
 
 # --- the runs planning makes besides the run ----------------------------------------------------------------------
