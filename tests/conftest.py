@@ -32,3 +32,72 @@ def line_problem(nx: int, radius=6.0, half_width=0.126):
 @pytest.fixture
 def e_star():
     return E_STAR
+
+
+# --- independent checks of a finished run --------------------------------------------------------------------------
+# The loop checks its running volume against its own invariant (and raises at 1e-9), so a test that reads its
+# `archard_volume_error` back cannot fail.  These recompute both sides from what a user sees instead: the final wear
+# fields, the element size, the contact length of a 2D model and the case's loading, so a wrong element area, line
+# length, block bookkeeping, unit or field written fails here.
+# Tolerance: the volume is Archard's by construction; what remains is the round-off of summing the depths of up to
+# ~10⁵ elements and of the loop's running sums (measured ≤ 6e-15 on every shipped case); 1e-9 is the loop's own
+# threshold (fretsim.simulate.ARCHARD_ROUND_OFF), and a wrong area, length or load is off by far more.
+VOLUME_ROUND_OFF = 1e-9
+
+
+def archard_travel(case, cycles: int) -> float:
+    """Σ Pᵢ·4δᵢ·nᵢ (N·mm) over the loading's blocks up to ``cycles``: the load times the rig's travel."""
+    total, start = 0.0, 0
+    for block in case.history():
+        n = min(max(cycles - start, 0), block.cycles)
+        total += block.normal_load * 4.0 * block.stroke * n
+        start += block.cycles
+    return total
+
+
+def _check_volumes(case, cycles: int, volumes, regime: str = "", gross_slip_stroke: float = float("nan")) -> None:
+    """Archard's law on worn volumes (mm³) after ``cycles`` of ``case`` (a filled case: its slip and stroke known).
+
+    The paper's cycle (slip uniform at mid-stroke): each body's volume is k·Σ Pᵢ·4δᵢ·Nᵢ, to round-off.  A cycle
+    that resolves friction or the stroke: no point slides further than the rig travels, so each volume lies in
+    (0, k·Σ Pᵢ·4δᵢ·Nᵢ] (0 for a body with k = 0); in gross slip under one constant loading each point slides at least
+    4(δ − δ_t) a cycle (its elastic take-up under μp is at most the centre's at the onset of gross slip, δ_t), so
+    the volume is at least k·P·4(δ − δ_t)·N."""
+    travel = archard_travel(case, cycles)
+    closed_form = case.slip == "uniform" and case.stroke_model == "mid_stroke"
+    for k, volume in zip(case.wear_coefficients(), volumes):
+        if closed_form:
+            assert volume == pytest.approx(k * travel, rel=VOLUME_ROUND_OFF, abs=0.0), (volume, k * travel)
+        elif k == 0 or cycles == 0:
+            assert volume == 0.0
+        else:
+            assert 0.0 < volume <= k * travel * (1 + VOLUME_ROUND_OFF), (volume, k * travel)
+            if regime == "gross_slip" and len(case.history()) == 1:
+                least = k * case.normal_load * 4.0 * (case.stroke - gross_slip_stroke) * cycles
+                assert volume >= least * (1 - VOLUME_ROUND_OFF), (volume, least)
+
+
+def worn_volumes(out) -> tuple[float, float]:
+    """Each body's worn volume (mm³) summed from its final wear field (mm): depth × element area, × the contact
+    length of a 2D (per unit length) model."""
+    g = out.setup.grid
+    area = g.dx * g.dy * (out.case.geometry.line_length if g.plane_strain else 1.0)
+    return float(np.sum(out.last.wear_moving)) * area, float(np.sum(out.last.wear_stationary)) * area
+
+
+def check_archard(out) -> None:
+    """Archard's law (see _check_volumes) on a finished run (an Outcome), from its final wear fields."""
+    assert out.status in ("complete", "stopped"), out.message
+    _check_volumes(out.case, int(out.last.cycle), worn_volumes(out), out.summary["regime"],
+                   out.summary["gross_slip_stroke_um"] * 1e-3)
+
+
+def check_archard_results(res) -> None:
+    """The same on a results file: its last recorded wear fields (µm), its grid and the filled case it stores."""
+    from fretsim.case import parse_case
+    case = parse_case(res.case_yaml)
+    dx = float(res.x[1] - res.x[0])
+    area = dx * (float(res.y[1] - res.y[0]) if res.y.size > 1 else case.geometry.line_length)
+    volumes = [float(np.sum(res.fields[f"wear_depth_{body}"][-1])) * 1e-3 * area for body in ("moving", "stationary")]
+    _check_volumes(case, int(res.fields["cycle"][-1]), volumes, res.summary["regime"],
+                   res.summary["gross_slip_stroke_um"] * 1e-3)
