@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import cylinder_problem
+from conftest import check_archard, cylinder_problem
 from fretsim.api import run
 from fretsim.case import CaseError, load_case
 from fretsim.plan import prepare
@@ -106,7 +106,7 @@ def test_either_body_with_a_zero_wear_coefficient_completes_with_the_default_sch
     cycles = min(cycles, LIMITED_CYCLES) if name in LIMITED else cycles
     out = run(load_case(CASES / f"{name}.yaml", [*quick(name, cycles), f"materials.{body}.wear_coefficient=0 1/MPa"]))
     assert out.status == "complete", out.message
-    assert out.summary["archard_volume_error"] < 1e-9
+    check_archard(out)  # the body without wear has none at all; the other its k·P·4δ·N (or within its bounds)
     # the paper's gap model is kept wherever it is stable on the grid, and replaced (with the reason) where not:
     # without wear of the moving body it is unstable whenever the stroke average has negative modes on the grid
     model = out.setup.cycle
@@ -185,7 +185,7 @@ def test_the_papers_adaptive_jumping_completes_on_the_default_grid(name, jumping
     cycles = ["loading.cycles=30000"] if name.startswith("kirk") else []
     out = run(load_case(CASES / f"{name}.yaml", ["model.dimension=2d", *cycles, *jumping]))
     assert out.status == "complete", out.message
-    assert out.summary["archard_volume_error"] < 1e-9  # the Taylor extrapolation conserves volume
+    check_archard(out)  # the Taylor extrapolation conserves volume: summed from the fields, k·P·4δ·N
 
 
 def test_paper_preset_is_scaled_to_the_grids_limit_and_says_so():

@@ -6,6 +6,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from conftest import check_archard
 from fretsim.api import load_case, run
 from fretsim.cli import main
 from fretsim.compliance import HalfSpace
@@ -59,7 +60,7 @@ def test_the_seat_rails_flat_scar_is_drawn_out_by_the_stroke_and_the_balls_is_ro
     ratio_s = np.ptp(X[worn_s]) / np.ptp(Y[worn_s])
     ratio_m = np.ptp(X[worn_m]) / np.ptp(Y[worn_m])
     assert ratio_s > 1.1 * ratio_m and abs(ratio_m - 1) < 0.1, (ratio_s, ratio_m)  # paper Figs. 24-25
-    assert out.summary["archard_volume_error"] < 1e-9
+    check_archard(out)  # the drawn-out scar holds k·P·4δ·N all the same
 
 
 # --- the tube's ring bending (Eq. 23) ------------------------------------------------------------------------------
@@ -217,4 +218,4 @@ def test_check_runs_on_every_shipped_case(name):
 def test_every_shipped_case_runs_and_keeps_archards_volume(name):
     out = run(load_case(CASES / f"{name}.yaml", ["loading.cycles=500", "output.snapshots=auto"]))
     assert out.status == "complete", out.message
-    assert out.summary["archard_volume_error"] < 1e-9
+    check_archard(out)  # summed from the final wear fields, against k·Σ P·4δ·N (or its bounds in partial slip)
