@@ -35,8 +35,15 @@ def quick(name: str, cycles: int) -> list[str]:
     if name in POINT:
         return [f"loading.cycles={min(cycles, 300)}", "output.snapshots=auto", *paper]
     return ["model.dimension=2d", f"loading.cycles={cycles}", "output.snapshots=auto", *paper]
+# one shipped case of each kind, for the tests that take every shipped case through quick(): a line contact (in 2D),
+# the partial-slip ball, a ball in gross slip, crossed cylinders, the tube, and the service tube whose explicit
+# limit is below a cycle.  The others take these paths with other numbers (roller_edge_rounded and
+# mccoll_185N_free_faces are mccoll_185N in 2D; the service tubes' first cycles lie in their first block): they run
+# in `pytest -m slow`
+KINDS = {"mccoll_185N", "ball_partial_slip", "seat_rail", "wire_rope", "tube_RT", "tube_service_90C"}
 # issue #9's targets at the defaults, at every recorded state, against the exact model on the same grid
 DEPTH, PRESSURE, P0 = 1e-3, 2e-2, 5e-3
+STEPPED_DEPTHS = ("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "centre_wear_depth_stationary_um")
 
 
 class States:
@@ -125,20 +132,34 @@ def test_the_papers_gap_model_forced_where_it_is_unstable_is_refused_with_advice
     assert run(load_case(CASES / "mccoll_185N.yaml", advice)).status == "complete"
 
 
-@pytest.mark.parametrize("fraction", [0.5, 0.9, 0.99])
-@pytest.mark.parametrize("name", SHIPPED)
-def test_linear_jumps_below_the_computed_limit_complete(name, fraction):
-    # up to 4000 cycles here (an instability shows within a few hundred steps); whole cases in the slow suite
+# explicit jumps are first order: their depths against the exact per-cycle run measured ≤ 6.5e-4 on the line
+# contacts (kirk_450N_200Hz at 0.99 of its limit) and 1.5e-3 on the partial-slip ball, whose 300 cycles are a
+# single jump; a jump that let a mode grow, or a wrong update, is off by far more
+LINEAR_DEPTH = 2e-3
+
+
+@pytest.mark.parametrize("name", [n if n in KINDS else pytest.param(n, marks=pytest.mark.slow) for n in SHIPPED])
+def test_linear_jumps_below_the_computed_limit_are_stable_and_meet_the_per_cycle_run(name):
+    """Jumps of 0.5, 0.9 and 0.99 of the computed limit, up to 4000 cycles (an instability shows within a few hundred
+    steps; whole cases in the slow suite): each completes, keeps Archard's volume (summed from its fields), and its
+    depths meet the exact per-cycle run's (linear jumps of one cycle) to a first-order scheme's error."""
     case = load_case(CASES / f"{name}.yaml", quick(name, 4000))
     limit = prepare(case)[0].stability_limit
-    jump = max(1, int(fraction * limit))
-    linear = [*quick(name, 4000), "jumping.scheme=linear", f"jumping.linear={jump}"]
+    linear = [*quick(name, 4000), "jumping.scheme=linear"]
     if limit < 1:  # no whole cycle is below the limit (the 90 °C tube in service, 80 µm stroke): refused, said so
         with pytest.raises(CaseError, match="exceeds the explicit stability limit"):
-            run(load_case(CASES / f"{name}.yaml", linear))
+            run(load_case(CASES / f"{name}.yaml", [*linear, "jumping.linear=1"]))
         return
-    out = run(load_case(CASES / f"{name}.yaml", linear))
-    assert out.status == "complete", out.message
+    exact = run(load_case(CASES / f"{name}.yaml", [*linear, "jumping.linear=1"]))
+    check_archard(exact)
+    jumps = sorted({max(1, int(fraction * limit)) for fraction in (0.5, 0.9, 0.99)} - {1})  # 1: the exact run
+    for jump in jumps:
+        out = run(load_case(CASES / f"{name}.yaml", [*linear, f"jumping.linear={jump}"]))
+        assert out.status == "complete", out.message
+        assert out.setup.linear_jump == jump < limit
+        check_archard(out)
+        worst = max(abs(out.summary[k] / exact.summary[k] - 1) for k in STEPPED_DEPTHS)
+        assert worst <= LINEAR_DEPTH, (jump, worst)
 
 
 @pytest.mark.slow
