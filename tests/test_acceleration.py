@@ -198,15 +198,23 @@ def test_an_unstable_linear_jump_forced_through_is_caught_by_its_growth():
     assert info.value.cycle < 20000
 
 
-@pytest.mark.parametrize("jumping", [["jumping.scheme=adaptive"], ["jumping.preset=paper"],
-                                     ["jumping.scheme=adaptive", "jumping.linear=10"]], ids=["defaults", "preset",
-                                                                                             "linear-10"])
-@pytest.mark.parametrize("name", ["mccoll_185N", "mccoll_1670N", "kirk_450N_20Hz"])
-def test_the_papers_adaptive_jumping_completes_on_the_default_grid(name, jumping):
+@pytest.mark.parametrize("name", ["mccoll_1670N", pytest.param("mccoll_185N", marks=pytest.mark.slow),
+                                  pytest.param("kirk_450N_20Hz", marks=pytest.mark.slow)])
+def test_the_papers_adaptive_jumping_on_the_default_grid_keeps_the_volume_and_meets_the_default_steps(name):
+    """The paper's adaptive jumps (its defaults, its preset, and with ΔN_L = 10) on the default grid: the Taylor
+    extrapolation keeps Archard's volume (summed from the fields), and the depths and the width land where the
+    default BDF2 steps do, within issue #9's depth target DEPTH (measured ≤ 6e-5; BDF2 itself is within 3e-5 of
+    the per-cycle run on mccoll_1670N)."""
     cycles = ["loading.cycles=30000"] if name.startswith("kirk") else []
-    out = run(load_case(CASES / f"{name}.yaml", ["model.dimension=2d", *cycles, *jumping]))
-    assert out.status == "complete", out.message
-    check_archard(out)  # the Taylor extrapolation conserves volume: summed from the fields, k·P·4δ·N
+    default = run(load_case(CASES / f"{name}.yaml", ["model.dimension=2d", *cycles])).summary
+    for jumping in (["jumping.scheme=adaptive"], ["jumping.preset=paper"], ["jumping.scheme=adaptive",
+                                                                            "jumping.linear=10"]):
+        out = run(load_case(CASES / f"{name}.yaml", ["model.dimension=2d", *cycles, *jumping]))
+        assert out.status == "complete", out.message
+        assert out.case.scheme == "adaptive" and out.summary["cycles"] == default["cycles"]
+        check_archard(out)  # the Taylor extrapolation conserves volume: summed from the fields, k·P·4δ·N
+        for key in (*STEPPED_DEPTHS, "scar_width_stationary_mm"):
+            assert out.summary[key] == pytest.approx(default[key], rel=DEPTH), (jumping, key)
 
 
 def test_paper_preset_is_scaled_to_the_grids_limit_and_says_so():
