@@ -13,7 +13,7 @@ from fretsim.compliance import HalfSpace
 from fretsim.compliance.ring import RingBending, chord_flexibility, ring_rigidity
 from fretsim.grid import Grid
 from fretsim.plan import prepare
-from fretsim.reference import effective_modulus, hertz_elliptical
+from fretsim.reference import effective_modulus, hertz_elliptical, hertz_line, hertz_point
 from fretsim.solvers import solve
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
@@ -208,10 +208,32 @@ def test_auto_leaves_out_ring_bending_that_changes_nothing_reported_and_says_so(
     assert choice.value == () and "0.1" in choice.reason and "within model.accuracy" in choice.reason
 
 
+def _hertz_printed(case) -> str:
+    """What `check` must print for the unworn contact, computed here from the case by a route of its own: Hertz's
+    line contact per unit length for the cylinders, rollers and tubes (their outer radius), the point contact for
+    balls and for crossed cylinders of equal radii (a ball of that radius), the elliptical one otherwise; to the
+    four significant digits `check` prints."""
+    g = case.geometry
+    e_star = effective_modulus(case.moving.youngs_modulus, case.moving.poissons_ratio,
+                               case.stationary.youngs_modulus, case.stationary.poissons_ratio)
+    if g.kind in ("cylinder_on_flat", "roller_on_flat", "tube_on_flat"):
+        h = hertz_line(case.normal_load / g.length, getattr(g, "outer_radius", None) or g.radius, e_star)
+        p0, widths = h.peak_pressure, [h.half_width]
+    elif g.kind == "ball_on_flat" or g.radius == g.radius_stationary:
+        h = hertz_point(case.normal_load, g.radius, e_star)
+        p0, widths = h.peak_pressure, [h.radius, h.radius]
+    else:
+        h = hertz_elliptical(case.normal_load, *g.radii_xy, e_star)
+        p0, widths = h.peak_pressure, [h.ax, h.ay]
+    return (f"unworn contact (Hertz): peak pressure p0 = {p0:.4g} MPa, half-width a = "
+            f"{' × '.join(f'{w * 1e3:.4g} µm' for w in widths)}, E* = {e_star * 1e-3:.4g} GPa")
+
+
 @pytest.mark.parametrize("name", SHIPPED)
-def test_check_runs_on_every_shipped_case(name):
+def test_check_runs_on_every_shipped_case_and_shows_its_hertz_contact(name):
     r = CliRunner().invoke(main, ["check", str(CASES / f"{name}.yaml")])
     assert r.exit_code == 0 and "choices:" in r.output, r.output
+    assert _hertz_printed(load_case(CASES / f"{name}.yaml")) in r.output, r.output
 
 
 @pytest.mark.parametrize("name", SHIPPED)
