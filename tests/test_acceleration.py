@@ -107,7 +107,7 @@ def test_bdf2_is_more_accurate_than_backward_euler_at_a_third_of_the_tolerance_w
 
 
 @pytest.mark.parametrize("body", ["moving", "stationary"])
-@pytest.mark.parametrize("name", SHIPPED)
+@pytest.mark.parametrize("name", [n if n in KINDS else pytest.param(n, marks=pytest.mark.slow) for n in SHIPPED])
 def test_either_body_with_a_zero_wear_coefficient_completes_with_the_default_scheme(name, body):
     cycles = load_case(CASES / f"{name}.yaml").cycles
     cycles = min(cycles, LIMITED_CYCLES) if name in LIMITED else cycles

@@ -236,7 +236,15 @@ def test_check_runs_on_every_shipped_case_and_shows_its_hertz_contact(name):
     assert _hertz_printed(load_case(CASES / f"{name}.yaml")) in r.output, r.output
 
 
-@pytest.mark.parametrize("name", SHIPPED)
+# one shipped case of each kind runs by default: a cylinder in 3D and in 2D, the partial-slip ball, a ball in gross
+# slip, crossed cylinders, the edge-rounded roller, the tube and the tube's load history with its wear limit.  The
+# others run these paths with other numbers (the free faces' run: tests/test_free_faces.py); `pytest -m slow`.
+RUN_DEFAULT = {"mccoll_185N", "table1_case1", "ball_partial_slip", "seat_rail", "wire_rope", "roller_edge_rounded",
+               "tube_RT", "tube_service_RT"}
+
+
+@pytest.mark.parametrize("name", [n if n in RUN_DEFAULT else pytest.param(n, marks=pytest.mark.slow)
+                                  for n in SHIPPED])
 def test_every_shipped_case_runs_and_keeps_archards_volume(name):
     out = run(load_case(CASES / f"{name}.yaml", ["loading.cycles=500", "output.snapshots=auto"]))
     assert out.status == "complete", out.message

@@ -111,8 +111,10 @@ def test_bad_histories_and_limits_are_refused_naming_the_key(loading, extra, pat
 LIMIT = "limits: {max_wear_depth_stationary: 0.8 um}\n"
 
 
-@pytest.mark.parametrize("loading", [SINGLE.replace("12000", "100000"), MIXED.replace("4000}", "90000}")],
-                         ids=["constant", "blocks"])
+# each costs an exact per-cycle run of ~10⁵ cycles: the load history by default (its crossing lies in a later
+# block); the constant loading's crossing is checked against a finer grid by default too (the estimate's test)
+@pytest.mark.parametrize("loading", [pytest.param(SINGLE.replace("12000", "100000"), marks=pytest.mark.slow),
+                                     MIXED.replace("4000}", "90000}")], ids=["constant", "blocks"])
 def test_the_limits_cycle_matches_the_exact_per_cycle_run(loading):
     """BDF2 lands on the crossing (taking a step again where it passed it) and interpolates it; the per-cycle
     update (linear jumps of one cycle: the paper's exact model) gives it to within a cycle.  They agree to the
