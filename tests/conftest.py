@@ -1,9 +1,36 @@
+import shutil
+import tempfile
+
 import numpy as np
 import pytest
+from hypothesis import settings
 
 from fretsim.compliance import HalfSpace
 from fretsim.grid import Grid
 from fretsim.reference import effective_modulus
+
+# No example database: it would be written to the current directory (.hypothesis/), shared by the parallel workers,
+# and make a run depend on the runs before it.  A failing example is still printed in full.
+settings.register_profile("fretsim", database=None)
+settings.load_profile("fretsim")
+_HYPOTHESIS_HOME: list = []
+
+
+def pytest_configure(config):
+    """Hypothesis also keeps caches in .hypothesis/ of the current directory (the constants it finds in the code
+    under test, gathered while the tests are collected): each process, each parallel worker, keeps them in a
+    temporary directory of its own instead, removed at its end."""
+    from hypothesis.configuration import set_hypothesis_home_dir
+    _HYPOTHESIS_HOME.append(tempfile.mkdtemp(prefix="fretsim-hypothesis-"))
+    set_hypothesis_home_dir(_HYPOTHESIS_HOME[-1])
+
+
+def pytest_unconfigure(config):
+    from hypothesis.configuration import set_hypothesis_home_dir
+    set_hypothesis_home_dir(None)
+    while _HYPOTHESIS_HOME:
+        shutil.rmtree(_HYPOTHESIS_HOME.pop(), ignore_errors=True)
+
 
 # The paper's steel pair: E = 200 GPa, ν = 0.3 on both bodies (internal units: MPa).
 E_STAR = effective_modulus(2.0e5, 0.3, 2.0e5, 0.3)

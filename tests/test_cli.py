@@ -176,15 +176,25 @@ def test_init_help_lists_the_shipped_cases_and_templates_and_completion_offers_t
     assert "mccoll_1670N" in _complete_kind(None, None, "mccoll_1") and _complete_kind(None, None, "zz") == []
 
 
+def _fresh(*args, cwd=None):
+    """The command in a process of its own: auto's proxy runs are kept for the rest of a process (a notebook's
+    check() then run() reuses them), so what a command announces and estimates depends on what ran before it in
+    the same process; these tests are about a fresh one, whatever ran before them in this worker."""
+    import subprocess
+    import sys
+    r = subprocess.run([sys.executable, "-m", "fretsim", *args], capture_output=True, text=True, cwd=cwd, timeout=600)
+    return r.returncode, r.stdout + r.stderr
+
+
 def test_autos_proxy_runs_are_announced_and_the_estimate_counts_them():
     """With `auto`, the proxies ran silently (49 s for the tube at 10⁸ cycles) while `check` estimated 0.23 s."""
-    r = CliRunner().invoke(main, ["check", str(CASES / "tube_RT.yaml"), "--set", "model.dimension=auto"])
-    assert r.exit_code == 0, r.output
-    assert "model.dimension auto: a 3D proxy run" in r.output and "jumping.tolerance 0.01" in r.output
+    code, output = _fresh("check", str(CASES / "tube_RT.yaml"), "--set", "model.dimension=auto")
+    assert code == 0, output
+    assert "model.dimension auto: a 3D proxy run" in output and "jumping.tolerance 0.01" in output
     # the total counts the run, its grid-error companions and the planning, which a run repeats
     m = re.search(r"about [0-9]+ contact solves, ([0-9.]+) s for the run .*companions \(2 runs on coarser grids\) "
-                  r"about ([0-9.]+) s more; planning took ([0-9.]+) s here .*: about ([0-9.]+) s in all", r.output)
-    assert m, r.output
+                  r"about ([0-9.]+) s more; planning took ([0-9.]+) s here .*: about ([0-9.]+) s in all", output)
+    assert m, output
     run_s, companions_s, planning_s, total_s = map(float, m.groups())
     assert planning_s > 1.0 and companions_s > 0
     assert total_s == pytest.approx(run_s + companions_s + planning_s, rel=0.1)  # each printed to 2 digits
@@ -225,28 +235,37 @@ def test_a_reader_that_goes_away_ends_the_command_quietly_with_141(tmp_path):
 
 
 def test_every_run_besides_the_runs_own_is_announced_and_a_proxy_is_not_run_twice(tmp_path):
-    r = CliRunner().invoke(main, ["run", str(CASES / "tube_RT.yaml"), "-o", str(tmp_path / "t.h5"), "--set",
-                                  "loading.cycles=20000"])
-    assert r.exit_code == 0, r.output
-    said = [line.split("] ", 1)[1] for line in r.output.splitlines() if line.startswith("[")]
+    code, output = _fresh("run", str(CASES / "tube_RT.yaml"), "-o", str(tmp_path / "t.h5"), "--set",
+                          "loading.cycles=20000")
+    assert code == 0, output
+    said = [line.split("] ", 1)[1] for line in output.splitlines() if line.startswith("[")]
     assert any("twice as coarse" in s for s in said) and any("four times as coarse" in s for s in said), said
     assert any(s.startswith("model.dimension auto") for s in said), said
     assert len(said) == len(set(said)), said  # the dimension's proxy case has its own corrections' proxies, and says
     #                                           so (its looser tolerance)
-    assert "grid-error companions" in r.output  # their time, beside the loop's
+    assert "grid-error companions" in output  # their time, beside the loop's
 
 
 def test_a_run_after_check_in_one_process_does_not_repeat_autos_proxy_runs():
-    # a notebook's check() then run(): the planning is the same, so the proxies are reused
-    import fretsim.plan as plan_module
-    from fretsim.api import check, load_case, run
-    case = load_case(CASES / "tube_RT.yaml", ["loading.cycles=20000", "grid.error_estimate=none"])
-    said: list = []
-    plan_module.announce = said.append
-    try:
+    # a notebook's check() then run(): the planning is the same, so the proxies are reused.  The notebook is a
+    # process of its own here, so that its check() plans from scratch whatever ran before in this worker (_fresh)
+    import subprocess
+    import sys
+    notebook = """if True:
+        import sys
+        import fretsim.plan as plan_module
+        from fretsim.api import check, load_case, run
+        case = load_case(sys.argv[1], ["loading.cycles=20000", "grid.error_estimate=none"])
+        said = []
+        plan_module.announce = said.append
         check(case)
         checked = len(said)
         out = run(case)
-    finally:
-        plan_module.announce = None
-    assert checked >= 4 and len(said) == checked and out.status == "complete", said
+        print(checked, len(said), out.status)
+        print(*said, sep="\\n")
+    """
+    r = subprocess.run([sys.executable, "-c", notebook, str(CASES / "tube_RT.yaml")], capture_output=True, text=True,
+                       timeout=600)
+    assert r.returncode == 0, r.stderr
+    checked, total, status = r.stdout.split("\n", 1)[0].split()
+    assert int(checked) >= 4 and int(total) == int(checked) and status == "complete", r.stdout

@@ -1,6 +1,5 @@
 """The contact–wear loop: the paper's Table 4, conservation, convergence, stability, and the results contract."""
 import functools
-import tempfile
 from pathlib import Path
 
 import h5py
@@ -25,24 +24,29 @@ CONVERGED = 0.01  # halving the jump and the element size moves the depth by < 1
 STEPPING = 1e-3
 
 
-OUT = Path(tempfile.mkdtemp(prefix="fretsim-tests-"))
+@pytest.fixture(scope="module")
+def results_of(tmp_path_factory):
+    """Runs a shipped case into this module's temporary directory once per process; its results as read back."""
+    out_dir = tmp_path_factory.mktemp("simulate")
+
+    @functools.lru_cache(maxsize=None)
+    def results_of(name: str, dimension: str, *overrides: str):
+        case = load_case(CASES / f"{name}.yaml", [f"model.dimension={dimension}", *overrides])
+        path = out_dir / f"{name}-{dimension}-{abs(hash(overrides))}.h5"
+        out = run(case, path, overwrite=True)
+        assert out.status == "complete", out.message
+        return read_results(path)
+
+    return results_of
 
 
-@functools.lru_cache(maxsize=None)
-def results_of(name: str, dimension: str, *overrides: str):
-    case = load_case(CASES / f"{name}.yaml", [f"model.dimension={dimension}", *overrides])
-    path = OUT / f"{name}-{dimension}-{abs(hash(overrides))}.h5"
-    out = run(case, path, overwrite=True)
-    assert out.status == "complete", out.message
-    return read_results(path)
-
-
-def summary_of(name: str, dimension: str, *overrides: str) -> dict:
-    return results_of(name, dimension, *overrides).summary
+@pytest.fixture(scope="module")
+def summary_of(results_of):
+    return lambda name, dimension, *overrides: results_of(name, dimension, *overrides).summary
 
 
 @pytest.mark.parametrize("name", sorted(TABLE4))
-def test_table4_depth_and_scar_width_in_3d(name):
+def test_table4_depth_and_scar_width_in_3d(name, results_of):
     depth, width = TABLE4[name]
     res = results_of(name, "3d")
     s = res.summary
@@ -52,7 +56,7 @@ def test_table4_depth_and_scar_width_in_3d(name):
 
 
 @pytest.mark.parametrize("name", sorted(TABLE4))
-def test_2d_centre_line_agrees_with_3d_within_the_end_load_share(name):
+def test_2d_centre_line_agrees_with_3d_within_the_end_load_share(name, results_of):
     # A finite cylinder's end peaks take part of the load off its centre line, most at the start (Fig. 5).
     # Wear depth follows the load, so the 3D/2D centre-line depth ratio must lie between the smallest and the
     # largest share of P/L the 3D centre line carries during the run (0.94-0.998 for these cases).
@@ -66,7 +70,7 @@ def test_2d_centre_line_agrees_with_3d_within_the_end_load_share(name):
     check_archard_results(r2)  # per unit length in 2D: the volume needs the line length
 
 
-def test_halving_the_jump_and_the_element_size_changes_the_depth_by_under_1pct():
+def test_halving_the_jump_and_the_element_size_changes_the_depth_by_under_1pct(summary_of):
     base = summary_of("mccoll_185N", "2d", "jumping.scheme=linear")
     nx = base["elements_x"]
     domain = nx * base["element_size_x_um"] * 1e-3
@@ -77,12 +81,12 @@ def test_halving_the_jump_and_the_element_size_changes_the_depth_by_under_1pct()
                                                                     rel=CONVERGED)
 
 
-def test_3d_wear_exceeds_the_centre_line_near_the_cylinder_ends():
+def test_3d_wear_exceeds_the_centre_line_near_the_cylinder_ends(summary_of):
     s = summary_of("mccoll_185N", "3d")
     assert s["max_wear_depth_stationary_um"] > s["centre_wear_depth_stationary_um"]  # end effect (Fig. 5)
 
 
-def test_linear_jumps_just_below_the_limit_are_not_false_alarms():
+def test_linear_jumps_just_below_the_limit_are_not_false_alarms(results_of):
     # issue #9: jumps of 38-42 cycles (limit 42.7) used to stop with a checkerboard alarm; their modes decay, so the
     # whole run lands where the default steps do on the same grid, and keeps Archard's volume
     implicit = results_of("mccoll_185N", "2d", "grid.rule=paper").summary
@@ -150,7 +154,7 @@ def test_runs_are_deterministic(tmp_path):
         assert np.array_equal(a.fields[name], b.fields[name], equal_nan=True)
 
 
-def test_wear_loop_with_the_papers_msm_matches_cg():
+def test_wear_loop_with_the_papers_msm_matches_cg(results_of):
     # two independent solvers in the full loop: every step's pressure agrees to solver tolerance, so must the wear
     a = results_of("mccoll_185N", "2d", "loading.cycles=2000", "solver.method=msm")
     b = results_of("mccoll_185N", "2d", "loading.cycles=2000", "solver.method=cg", "solver.tolerance=1e-12")
@@ -159,7 +163,7 @@ def test_wear_loop_with_the_papers_msm_matches_cg():
 
 
 @pytest.mark.slow
-def test_3d_halving_the_jump_and_the_element_size_changes_the_depth_by_under_1pct():
+def test_3d_halving_the_jump_and_the_element_size_changes_the_depth_by_under_1pct(summary_of):
     base = summary_of("mccoll_185N", "3d", "jumping.scheme=linear")
     nx, ny = base["elements_x"], base["elements_y"]
     domain = nx * base["element_size_x_um"] * 1e-3
