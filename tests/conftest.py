@@ -1,13 +1,25 @@
+import os
 import shutil
+import sys
 import tempfile
 
-import numpy as np
-import pytest
-from hypothesis import settings
+if os.environ.get("PYTEST_XDIST_WORKER"):
+    # A parallel worker has a core of its own: OpenBLAS's threads (one per core by default) would spin against the
+    # other worker's, which made the banded solves of tests/test_free_faces.py five times slower.  Before numpy
+    # is first imported, or it is too late (a plugin that imports it first leaves the threads as they are: slower).
+    if "numpy" in sys.modules:
+        import warnings
+        warnings.warn("numpy was imported before tests/conftest.py: its BLAS threads are not limited to 1 per worker")
+    for _var in ("OPENBLAS_NUM_THREADS", "OMP_NUM_THREADS", "MKL_NUM_THREADS"):
+        os.environ.setdefault(_var, "1")
 
-from fretsim.compliance import HalfSpace
-from fretsim.grid import Grid
-from fretsim.reference import effective_modulus
+import numpy as np  # noqa: E402
+import pytest  # noqa: E402
+from hypothesis import settings  # noqa: E402
+
+from fretsim.compliance import HalfSpace  # noqa: E402
+from fretsim.grid import Grid  # noqa: E402
+from fretsim.reference import effective_modulus  # noqa: E402
 
 # No example database: it would be written to the current directory (.hypothesis/), shared by the parallel workers,
 # and make a run depend on the runs before it.  A failing example is still printed in full.

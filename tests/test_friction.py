@@ -68,6 +68,11 @@ def fretting_cycle(grid, c, k, stroke, load, mu, volume_factor=1.0, **kw):
                         volume_factor=volume_factor, **kw)
 
 
+# under pytest-xdist the module runs on one worker: its tests share the per-cycle runs of its module fixtures (the
+# partial-slip one is 3000 Coulomb cycles), which each worker would otherwise run again
+pytestmark = pytest.mark.xdist_group("test_friction")
+
+
 # --- the tangential operator and solver -------------------------------------------------------------------------
 
 def test_cerruti_rectangle_matches_a_quadrature_of_the_point_force_solution():

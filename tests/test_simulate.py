@@ -24,6 +24,10 @@ CONVERGED = 0.01  # halving the jump and the element size moves the depth by < 1
 STEPPING = 1e-3
 
 
+# under pytest-xdist the module runs on one worker: its tests share the runs results_of keeps
+pytestmark = pytest.mark.xdist_group("test_simulate")
+
+
 @pytest.fixture(scope="module")
 def results_of(tmp_path_factory):
     """Runs a shipped case into this module's temporary directory once per process; its results as read back."""
