@@ -6,7 +6,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from conftest import cylinder_problem
+from conftest import check_archard, cylinder_problem
 from fretsim.api import run
 from fretsim.case import CaseError, load_case
 from fretsim.plan import prepare
@@ -36,8 +36,15 @@ def quick(name: str, cycles: int) -> list[str]:
     if name in POINT:
         return [f"loading.cycles={min(cycles, 300)}", "output.snapshots=auto", *paper]
     return ["model.dimension=2d", f"loading.cycles={cycles}", "output.snapshots=auto", *paper]
+# one shipped case of each kind, for the tests that take every shipped case through quick(): a line contact (in 2D),
+# the partial-slip ball, a ball in gross slip, crossed cylinders, the tube, and the service tube whose explicit
+# limit is below a cycle.  The others take these paths with other numbers (roller_edge_rounded and
+# mccoll_185N_free_faces are mccoll_185N in 2D; the service tubes' first cycles lie in their first block): they run
+# in `pytest -m slow`
+KINDS = {"mccoll_185N", "ball_partial_slip", "seat_rail", "wire_rope", "tube_RT", "tube_service_90C"}
 # issue #9's targets at the defaults, at every recorded state, against the exact model on the same grid
 DEPTH, PRESSURE, P0 = 1e-3, 2e-2, 5e-3
+STEPPED_DEPTHS = ("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "centre_wear_depth_stationary_um")
 
 
 class States:
@@ -101,13 +108,13 @@ def test_bdf2_is_more_accurate_than_backward_euler_at_a_third_of_the_tolerance_w
 
 
 @pytest.mark.parametrize("body", ["moving", "stationary"])
-@pytest.mark.parametrize("name", SHIPPED)
+@pytest.mark.parametrize("name", [n if n in KINDS else pytest.param(n, marks=pytest.mark.slow) for n in SHIPPED])
 def test_either_body_with_a_zero_wear_coefficient_completes_with_the_default_scheme(name, body):
     cycles = load_case(CASES / f"{name}.yaml").loading.cycles
     cycles = min(cycles, LIMITED_CYCLES) if name in LIMITED else cycles
     out = run(load_case(CASES / f"{name}.yaml", [*quick(name, cycles), f"materials.{body}.wear_coefficient=0 1/MPa"]))
     assert out.status == "complete", out.message
-    assert out.summary["archard_volume_error"] < 1e-9
+    check_archard(out)  # the body without wear has none at all; the other its k·P·4δ·N (or within its bounds)
     # the paper's gap model is kept wherever it is stable on the grid, and replaced (with the reason) where not:
     # without wear of the moving body it is unstable whenever the stroke average has negative modes on the grid
     model = out.setup.cycle
@@ -127,20 +134,34 @@ def test_the_papers_gap_model_forced_where_it_is_unstable_is_refused_with_advice
     assert run(load_case(CASES / "mccoll_185N.yaml", advice)).status == "complete"
 
 
-@pytest.mark.parametrize("fraction", [0.5, 0.9, 0.99])
-@pytest.mark.parametrize("name", SHIPPED)
-def test_linear_jumps_below_the_computed_limit_complete(name, fraction):
-    # up to 4000 cycles here (an instability shows within a few hundred steps); whole cases in the slow suite
+# explicit jumps are first order: their depths against the exact per-cycle run measured ≤ 6.5e-4 on the line
+# contacts (kirk_450N_200Hz at 0.99 of its limit) and 1.5e-3 on the partial-slip ball, whose 300 cycles are a
+# single jump; a jump that let a mode grow, or a wrong update, is off by far more
+LINEAR_DEPTH = 2e-3
+
+
+@pytest.mark.parametrize("name", [n if n in KINDS else pytest.param(n, marks=pytest.mark.slow) for n in SHIPPED])
+def test_linear_jumps_below_the_computed_limit_are_stable_and_meet_the_per_cycle_run(name):
+    """Jumps of 0.5, 0.9 and 0.99 of the computed limit, up to 4000 cycles (an instability shows within a few hundred
+    steps; whole cases in the slow suite): each completes, keeps Archard's volume (summed from its fields), and its
+    depths meet the exact per-cycle run's (linear jumps of one cycle) to a first-order scheme's error."""
     case = load_case(CASES / f"{name}.yaml", quick(name, 4000))
     limit = prepare(case)[0].stability_limit
-    jump = max(1, int(fraction * limit))
-    linear = [*quick(name, 4000), "jumping.scheme=linear", f"jumping.linear={jump}"]
+    linear = [*quick(name, 4000), "jumping.scheme=linear"]
     if limit < 1:  # no whole cycle is below the limit (the 90 °C tube in service, 80 µm stroke): refused, said so
         with pytest.raises(CaseError, match="exceeds the explicit stability limit"):
-            run(load_case(CASES / f"{name}.yaml", linear))
+            run(load_case(CASES / f"{name}.yaml", [*linear, "jumping.linear=1"]))
         return
-    out = run(load_case(CASES / f"{name}.yaml", linear))
-    assert out.status == "complete", out.message
+    exact = run(load_case(CASES / f"{name}.yaml", [*linear, "jumping.linear=1"]))
+    check_archard(exact)
+    jumps = sorted({max(1, int(fraction * limit)) for fraction in (0.5, 0.9, 0.99)} - {1})  # 1: the exact run
+    for jump in jumps:
+        out = run(load_case(CASES / f"{name}.yaml", [*linear, f"jumping.linear={jump}"]))
+        assert out.status == "complete", out.message
+        assert out.setup.linear_jump == jump < limit
+        check_archard(out)
+        worst = max(abs(out.summary[k] / exact.summary[k] - 1) for k in STEPPED_DEPTHS)
+        assert worst <= LINEAR_DEPTH, (jump, worst)
 
 
 @pytest.mark.slow
@@ -179,15 +200,23 @@ def test_an_unstable_linear_jump_forced_through_is_caught_by_its_growth():
     assert info.value.cycle < 20000
 
 
-@pytest.mark.parametrize("jumping", [["jumping.scheme=adaptive"], ["jumping.preset=paper"],
-                                     ["jumping.scheme=adaptive", "jumping.linear=10"]], ids=["defaults", "preset",
-                                                                                             "linear-10"])
-@pytest.mark.parametrize("name", ["mccoll_185N", "mccoll_1670N", "kirk_450N_20Hz"])
-def test_the_papers_adaptive_jumping_completes_on_the_default_grid(name, jumping):
+@pytest.mark.parametrize("name", ["mccoll_1670N", pytest.param("mccoll_185N", marks=pytest.mark.slow),
+                                  pytest.param("kirk_450N_20Hz", marks=pytest.mark.slow)])
+def test_the_papers_adaptive_jumping_on_the_default_grid_keeps_the_volume_and_meets_the_default_steps(name):
+    """The paper's adaptive jumps (its defaults, its preset, and with ΔN_L = 10) on the default grid: the Taylor
+    extrapolation keeps Archard's volume (summed from the fields), and the depths and the width land where the
+    default BDF2 steps do, within issue #9's depth target DEPTH (measured ≤ 6e-5; BDF2 itself is within 3e-5 of
+    the per-cycle run on mccoll_1670N)."""
     cycles = ["loading.cycles=30000"] if name.startswith("kirk") else []
-    out = run(load_case(CASES / f"{name}.yaml", ["model.dimension=2d", *cycles, *jumping]))
-    assert out.status == "complete", out.message
-    assert out.summary["archard_volume_error"] < 1e-9  # the Taylor extrapolation conserves volume
+    default = run(load_case(CASES / f"{name}.yaml", ["model.dimension=2d", *cycles])).summary
+    for jumping in (["jumping.scheme=adaptive"], ["jumping.preset=paper"], ["jumping.scheme=adaptive",
+                                                                            "jumping.linear=10"]):
+        out = run(load_case(CASES / f"{name}.yaml", ["model.dimension=2d", *cycles, *jumping]))
+        assert out.status == "complete", out.message
+        assert out.case.scheme == "adaptive" and out.summary["cycles"] == default["cycles"]
+        check_archard(out)  # the Taylor extrapolation conserves volume: summed from the fields, k·P·4δ·N
+        for key in (*STEPPED_DEPTHS, "scar_width_stationary_mm"):
+            assert out.summary[key] == pytest.approx(default[key], rel=DEPTH), (jumping, key)
 
 
 def test_paper_preset_is_scaled_to_the_grids_limit_and_says_so():

@@ -29,6 +29,10 @@ def _finer(name, out, factor, extra=()):
     return run(load_case(CASES / f"{name}.yaml", ov))
 
 
+# under pytest-xdist the module runs on one worker: the depth and the pressure tests share each case's runs
+pytestmark = pytest.mark.xdist_group("test_grid_error")
+
+
 @functools.lru_cache(maxsize=None)
 def _default_and_reference(name):
     out = run(load_case(CASES / f"{name}.yaml", ["model.dimension=2d"]))

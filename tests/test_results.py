@@ -13,10 +13,10 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
+from conftest import check_archard
 from fretsim.api import load_case, run
 from fretsim.case import parse_case
 from fretsim.cli import main
-from fretsim.plan import prepare
 from fretsim.results import read_results
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -212,12 +212,22 @@ def test_every_schema_key_is_in_the_reference_and_accepted_by_the_parser():
             assert f"`geometry.{key}` ({kind})" in page
 
 
-@pytest.mark.parametrize("kind", ["cylinder_on_flat", "ball_on_flat", "crossed_cylinders", "mccoll_185N"])
-def test_init_templates_run_as_they_are(kind, tmp_path):
+@pytest.mark.parametrize("kind", [
+    "cylinder_on_flat", "ball_on_flat", "crossed_cylinders", "mccoll_185N",
+    # found by this test: the crowned roller's contact (500 mm crown) is wider along x than the straight line
+    # contact the automatic domain is sized from, and reaches its x edge (at cycle 0 in 50 cycles; at cycle 15 444
+    # of the template's own 18 000).  Remove the mark when the grid sizing accounts for the crown.
+    pytest.param("roller_on_flat", marks=pytest.mark.xfail(strict=True, raises=AssertionError,
+                                                            reason="the automatic grid does not hold a crowned "
+                                                                   "roller's contact")),
+])
+def test_init_templates_run_as_they_are(kind):
     from fretsim.templates import template_text
     case = parse_case(template_text(kind), overrides=["loading.cycles=50"])
-    setup, _, _ = prepare(case)
-    assert setup.cycles == 50
+    out = run(case)
+    assert out.status == "complete", out.message
+    assert out.summary["cycles"] == 50
+    check_archard(out)  # the template's wear coefficients, load and stroke give its volumes: k·P·4δ·N
 
 
 def test_init_refuses_to_overwrite_and_names_the_choices(tmp_path, monkeypatch):

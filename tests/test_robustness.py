@@ -207,8 +207,13 @@ def long_reference(tmp_path_factory):
     return read_results(path)
 
 
-@pytest.mark.parametrize("sig, code, status", [(signal.SIGINT, 130, "interrupted"), (signal.SIGTERM, 130, "interrupted"),
-                                               (signal.SIGKILL, -9, "running")])
+# each signal costs a whole long run (the kill at 200 rows, then its resume): SIGKILL by default, the hardest (the
+# process writes nothing more; its last flush must stand); Ctrl-C's and SIGTERM's handler in `pytest -m slow` (a real
+# Ctrl-C's file: test_reliability.py; an API interrupt's resume: test_interrupted_runs_resume_to_identical_arrays)
+@pytest.mark.parametrize("sig, code, status", [
+    pytest.param(signal.SIGINT, 130, "interrupted", marks=pytest.mark.slow),
+    pytest.param(signal.SIGTERM, 130, "interrupted", marks=pytest.mark.slow),
+    (signal.SIGKILL, -9, "running")])
 def test_signalled_run_keeps_its_steps_and_resumes_identically(tmp_path, long_reference, sig, code, status):
     out, got = _kill_at(tmp_path, sig, 200, sig.name)
     assert got == code

@@ -227,7 +227,10 @@ def _alive(pid: int) -> bool:
 
 
 @pytest.mark.skipif(not Path("/proc/self/stat").exists(), reason="reads /proc")
-@pytest.mark.parametrize("sig", [signal.SIGTERM, signal.SIGKILL], ids=["sigterm", "sigkill"])
+# each costs a sweep of single-cycle steps run to the end: SIGTERM by default (it checks the table and the exit
+# code too); SIGKILL, which checks the workers' death alone, in `pytest -m slow`
+@pytest.mark.parametrize("sig", [signal.SIGTERM, pytest.param(signal.SIGKILL, marks=pytest.mark.slow)],
+                         ids=["sigterm", "sigkill"])
 def test_a_signalled_sweep_takes_its_workers_with_it(tmp_path, sig):
     """Only the sweep process is signalled (a batch system's kill, not a terminal's Ctrl-C to the group): its
     workers used to live on (PPID 1, >100 MB each) holding the caller's stdout, and SIGTERM wrote no table.  Now
