@@ -469,7 +469,9 @@ def _fuzz(tmp_path, good_file, genuine, m):
     _judge(path, tmp_path, genuine)
 
 
-@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+# Derandomised by default: one flip among the random ones can make libhdf5 loop for ever (the strict xfail
+# above), and a default run must not hang on a rare draw; the slow run below keeps drawing fresh flips.
+@settings(max_examples=30, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(mutation())
 def test_mutated_results_files_never_give_a_traceback_or_a_false_complete(tmp_path, good_file, genuine_resume, m):
     _fuzz(tmp_path, good_file, genuine_resume, m)
