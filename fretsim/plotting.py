@@ -511,6 +511,22 @@ def _mark_blocks_and_limit(res: Results, axes) -> None:
             axes[0].axhline(um, color="C3", lw=0.8, ls=":", label=f"limit {text}")
 
 
+def _loop_facts(res: Results) -> str:
+    """What an engineer reads off a fretting loop, stated: the regime, μ, Q*/μP, δ_t and the energy per cycle."""
+    s, mu, load = res.summary, _float(res, "friction_coefficient"), _float(res, "normal_load")
+    lines = [f"regime: {str(s.get('regime', '?')).replace('_', ' ')}" + (f", μ = {mu:.3g}" if mu is not None else "")]
+    q_star = s.get("tangential_force_amplitude_N")
+    if q_star is not None and mu and load:
+        lines.append(f"Q*/μP = {float(q_star) / (mu * load):.3g} (Q* = {float(q_star):.4g} N)")
+    d_t = s.get("gross_slip_stroke_um")
+    if d_t is not None and np.isfinite(float(d_t)):
+        lines.append(f"gross slip from δ_t = {float(d_t):.3g} µm (unworn)")
+    energy = s.get("dissipated_energy_per_cycle_J")
+    if energy is not None and np.isfinite(float(energy)):
+        lines.append(f"energy {float(energy) * 1e3:.4g} mJ per cycle")
+    return "\n".join(lines)
+
+
 def _fretting(res: Results):
     """The fretting loop at each snapshot, the slip distance per cycle of both bodies across the contact, and
     where the contact sticks: the shear traction against μp along y = 0 (2D) or the moving body's slip map (3D)."""
@@ -526,7 +542,9 @@ def _fretting(res: Results):
     ax.set_xlabel(f"applied displacement ({_unit(res, 'fretting_loop/displacement')})")
     ax.set_ylabel(f"tangential force Q ({_unit(res, 'fretting_loop/tangential_force')})")
     ax.set_title("fretting loop")
-    ax.legend(fontsize=8)
+    ax.legend(fontsize=8, loc="lower right")
+    ax.text(0.5, 0.5, _loop_facts(res), transform=ax.transAxes, va="center", ha="center", fontsize=8,
+            bbox=dict(boxstyle="round", fc="white", ec="0.7", alpha=0.9))
     ax = axes[1]
     last = len(res.fields["cycle"]) - 1
     unit = _unit(res, "fields/slip_distance_moving")

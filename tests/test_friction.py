@@ -311,6 +311,49 @@ def test_the_loops_area_is_the_dissipated_energy():
     assert area == pytest.approx(cyc.energy, rel=2e-3)  # the trapezoid rule on 202 points of a smooth loop
 
 
+def _side_um(u, q):
+    """The rig travel from the loop's top turning point (+Q*) to where the force first reaches −Q* again."""
+    ok = np.isfinite(u)
+    u, q = u[ok], q[ok]
+    top = int(np.argmax(u))
+    reach = next(i for i in range(top, u.size) if q[i] <= -abs(q[top]) * (1 - 1e-6))
+    return u[top] - u[reach]
+
+
+@pytest.mark.parametrize("factor", [1.5, 40.0])
+def test_the_recorded_loops_elastic_side_spans_what_a_finely_stepped_loop_does(factor):
+    """Evenly spaced increments (2δ/9) slid the whole contact in the first increment after reversal, so the loop's
+    side spanned 2δ/9, several times 2δ_t, and a tangential stiffness read off it was that many times too
+    compliant.  The recorded loop must span the side as a loop stepped 400 times per half-stroke does, within 10 %,
+    just above the transition and far above it; and be the same loop (the force at each recorded displacement)."""
+    grid, c, k, normal, a = ball_contact(40)
+    mu = 0.6
+    stroke = factor * M.ball_gross_slip_displacement(mu, 185.0, a, BODIES)
+    member = fretting_cycle(grid, c, k, stroke, 185.0, mu)
+    cyc = member.solve(np.zeros(grid.shape), np.zeros(grid.shape), normal, None)
+    assert cyc.regime == "gross_slip"
+    # the reference: the same tangential solver driven in 2δ/400 increments round the loop, the pressure fixed
+    p, q = cyc.pressure, np.zeros(grid.shape)
+    q, _, _, _ = member._tangential(q, p, -stroke)
+    us, qs, n = [-stroke], [float(q.sum()) * grid.area], 400
+    for u0, u1 in [(-stroke + 2 * stroke * j / n, -stroke + 2 * stroke * (j + 1) / n) for j in range(n)] + \
+                  [(stroke - 2 * stroke * j / n, stroke - 2 * stroke * (j + 1) / n) for j in range(n)]:
+        q, _, _, _ = member._tangential(q, p, u1 - u0)
+        us.append(u1)
+        qs.append(float(q.sum()) * grid.area)
+    fine = _side_um(np.array(us), np.array(qs))
+    recorded = _side_um(*cyc.loop)
+    assert recorded == pytest.approx(fine, rel=0.10)
+    if factor > 10:  # McColl's 185 N at 25 µm is 37× δ_t: the old loop's first increment, 2δ/9, slid it all
+        assert 2 * stroke / 9 > 4 * fine
+    # and its points lie on the fine loop: the down-stroke's force at each recorded displacement
+    u, f = cyc.loop
+    top = int(np.argmax(u))
+    down_fine = slice(n, 2 * n + 1)  # from the top turning point (+δ) down
+    at = np.interp(-u[top:], -np.array(us)[down_fine], np.array(qs)[down_fine])
+    assert np.abs(f[top:] - at).max() < 0.02 * mu * 185.0  # the fine loop's own interpolation error, side curvature
+
+
 # --- whole runs ---------------------------------------------------------------------------------------------------
 
 CASES = __import__("pathlib").Path(__file__).resolve().parents[1] / "cases"
@@ -461,7 +504,12 @@ def test_a_coulomb_run_records_its_loop_slips_energy_and_regime(tmp_path):
     elastic_um = 25.0 - s["dissipated_energy_per_cycle_J"] * 1e3 / (4 * 0.9 * 185.0) * 1e3
     assert 0 < elastic_um < s["gross_slip_stroke_um"]
     loop = res.fretting_loop
-    assert loop["displacement"].shape == loop["tangential_force"].shape == (2, 2 * 9 + 1)
+    # the loading quarter's end, then each half-stroke: its elastic side in 12 increments and the sliding rest in one
+    assert loop["displacement"].shape == loop["tangential_force"].shape == (2, 1 + 2 * (12 + 1))
+    # Masing: at cycle 0 the traction reverses over 2δ_t of the unworn contact (the summary's), the side's end on an
+    # increment; 1 %: the last point to slide is one element off the centre section's maximum at most
+    assert _side_um(loop["displacement"][0], loop["tangential_force"][0]) == pytest.approx(
+        2 * s["gross_slip_stroke_um"], rel=0.01)
     assert np.nanmax(np.abs(loop["displacement"])) == pytest.approx(25.0)
     slip = res.fields["slip_distance_moving"][-1]
     assert slip.max() < 100.0 and slip.max() > 95.0  # 4δ = 100 µm less the elastic take-up
@@ -474,7 +522,7 @@ def test_a_coulomb_run_records_its_loop_slips_energy_and_regime(tmp_path):
     names = [p.name for p in export_csv(res, tmp_path / "csv")]
     assert "fretting_loop.csv" in names
     rows = (tmp_path / "csv" / "fretting_loop.csv").read_text().splitlines()
-    assert rows[0] == "cycle,displacement [um],tangential_force [N]" and len(rows) == 1 + 2 * 19
+    assert rows[0] == "cycle,displacement [um],tangential_force [N]" and len(rows) == 1 + 2 * 27
 
 
 @pytest.mark.slow

@@ -55,6 +55,8 @@ CORRECTIONS = 1  # fixed-point corrections of an implicit step's gap for the wea
 SPREAD_TO_CORRECT = 0.1  # ... where the slip varies by more than this share of its largest (1 − mean/max): in gross
 #                         slip far above δ_t every point slides nearly alike, the linearisation is nearly exact
 #                         (McColl 185 N: 1e-5 without the correction) and the correction would cost 1.5× the time
+LOOP_SIDE_INCREMENTS = 12  # increments over the fretting loop's elastic side at a recorded state (mid-stroke): the
+#                          side ends on an increment, so its span is exact; 12 draw Mindlin's curve to ~1 % of Q*
 TRAVEL_TOLERANCE = 0.1  # of an element: a resolved increment is solved again where a point's predicted travel was off
 #                         by more (the pressure follows the worn flat on that scale)
 
@@ -147,6 +149,30 @@ class CoulombCycle:
         down = [(d - 2 * d * k / n, d - 2 * d * (k + 1) / n, True) for k in range(n)]
         return quarter + up + down
 
+    def loop_path(self, side: float) -> list[tuple[float, float, bool]]:
+        """The increments of a recorded cycle with the pressure fixed: each half-stroke's elastic side, the first
+        ``side`` (mm) of rig travel after a reversal, in LOOP_SIDE_INCREMENTS (or model.increments) equal parts, the rest (sliding at
+        ±μP, a straight line) in one.  With the pressure fixed a monotone half-stroke's wear does not depend on
+        how it is cut (each point slips one way), so this changes the loop's shape, not the wear: evenly spaced
+        increments (2δ/9 each) slid the whole contact in the first increment after reversal and drew the sides
+        several times wider than 2δ_t."""
+        d = self.stroke
+        side = min(max(side, 0.0), 2.0 * d)
+        m = max(LOOP_SIDE_INCREMENTS, self.increments)  # model.increments asks for a finer loop, never coarser
+        offsets = [side * k / m for k in range(m + 1)] + ([2.0 * d] if side < 2.0 * d * (1 - 1e-9) else [])
+        offsets[-1] = 2.0 * d  # the turning point exactly, whatever the rounding
+        up = [(-d + a, -d + b, True) for a, b in zip(offsets[:-1], offsets[1:])]
+        down = [(d - a, d - b, True) for a, b in zip(offsets[:-1], offsets[1:])]
+        return [(0.0, -d, False)] + up + down
+
+    def elastic_side(self, pressure: np.ndarray) -> float:
+        """2δ_t over the whole contact (mm): the rig travel after a reversal before the last point slides again
+        (Masing: twice the first loading's), where the loop's side ends; 2δ where it never does (partial slip)."""
+        on = pressure > 0
+        if self.rigid or not on.any():
+            return 0.0
+        return 2.0 * float(self.tangential(self.friction_coefficient * pressure)[on].max())
+
     def solve(self, wear_moving, wear_stationary, normal, guess, step: float = 0.0, memory=None,
               cycle: int = 0, detail: bool = True) -> Cycle:
         """One cycle; an implicit step's (``step`` > 0) corrected CORRECTIONS times for its linearisation."""
@@ -175,10 +201,14 @@ class CoulombCycle:
             fixed = normal(seen, guess, extra, load=self.load, cycle=cycle)
         tally = _Tally(shape, self.grid.area * self.volume_factor)
         q, s = np.zeros(shape), np.zeros(shape)
-        first = (n + 1) // 2  # the loop's first increment (after the loading quarter)
-        mid, end = first + n // 2, first + n - 1  # centred on U = 0 going up; the up-stroke's end, U = +δ
+        path = (self.loop_path(self.elastic_side(fixed[0])) if detail and not self.resolved and not self.rigid
+                else self.path(n))
+        first = next(k for k, step in enumerate(path) if step[2])  # the loop's first increment (after the quarter)
+        # the increment over U = 0 going up (centred on it for the resolved stroke's odd count); the up-stroke's end
+        mid = next(k for k in range(first, len(path)) if path[k][0] < 0.0 <= path[k][1])
+        end = max(k for k in range(first, len(path)) if path[k][1] > path[k][0])
         p_prev, ds_prev, du_prev = guess, None, None
-        for k, (u0, u1, counted) in enumerate(self.path(n)):
+        for k, (u0, u1, counted) in enumerate(path):
             if k == first:
                 tally.loop(u0, q)
             du = u1 - u0
@@ -189,7 +219,7 @@ class CoulombCycle:
                 (p, res), (q_new, ds, stuck, its) = fixed, self._tangential(q, fixed[0], du)
                 tally.iterations += its
             if counted:
-                tally.add(self, p, q_new, s, ds)
+                tally.add(self, p, q_new, s, ds, abs(du) / (4.0 * self.stroke))
                 tally.loop(u1, q_new)
             if k == mid:
                 p_mid, res_mid, travel_mid = p, res, (s, s + ds)
@@ -197,7 +227,6 @@ class CoulombCycle:
                 stick_end = stuck & (p > 0)
             s, q = s + ds, q_new
             p_prev, ds_prev, du_prev = p, ds, du
-        tally.p_seen /= 2 * n
         defect, mismatch = 0.0, None
         if step:
             defect, mismatch = self._defect(wear_moving, wear_stationary, step, w_lin, tally, p_mid, travel_mid,
@@ -282,15 +311,16 @@ class _Tally:
         self.loop_u.append(u)
         self.loop_q.append(float(q.sum()) * self.area)
 
-    def add(self, member: "CoulombCycle", p, q_new, s, ds) -> None:
-        """One counted increment: the moving body wears at its own points, the flat where each point travelled."""
+    def add(self, member: "CoulombCycle", p, q_new, s, ds, share: float) -> None:
+        """One counted increment, ``share`` of the cycle's rig travel: the moving body wears at its own points, the
+        flat where each point travelled; the flat's pressure is averaged over the rig's travel."""
         dx, kernel = member.grid.dx, member.kernel
         amount = member.law.amount(p, q_new, ds)
         self.rate_m += member.k_moving * amount
         self.rate_s += member.k_stationary * sweep_deposit(amount, s, s + ds, dx, kernel)
         self.slip_m += np.abs(ds)
         self.slip_s += sweep_deposit(np.abs(ds), s, s + ds, dx, kernel)
-        self.p_seen += sweep_deposit(p, s, s + ds, dx, kernel)
+        self.p_seen += share * sweep_deposit(p, s, s + ds, dx, kernel)
         self.energy += float((np.abs(q_new) * np.abs(ds)).sum()) * self.area
         self.work += float(amount.sum()) * self.area
         self.shear = np.maximum(self.shear, np.abs(q_new))
