@@ -93,7 +93,18 @@ GEOMETRY_KEYS: dict[str, dict[str, Key]] = {
                       plausible=LENGTH_RANGE, example="10 mm"),
         "block_length": Key("length", "the flat's length along y when it ends in free faces, centred on the "
                                       "cylinder (McColl's flat: as long as the cylinder; at least L); omitted: the "
-                                      "flat runs on well beyond the contact", None, plausible=LENGTH_RANGE)},
+                                      "flat runs on well beyond the contact", None, plausible=LENGTH_RANGE),
+        "flat_width": Key("length", "the flat as a block: its width along x, centred on the contact; its far face "
+                                    "(flat_thickness below the contact) carries the stroke, and the block's tangential "
+                                    "compliance, from a one-off plane-strain solve, replaces the half-space's datum "
+                                    "(give both; omitted: a half-space)", None, plausible=LENGTH_RANGE,
+                          example="12 mm"),
+        "flat_thickness": Key("length", "the flat block's height, from the contact to the face that carries the "
+                                        "stroke (with flat_width)", None, plausible=LENGTH_RANGE, example="6 mm"),
+        "moving_height": Key("length", "where the cylinder is held, measured from the contact (at most R: the "
+                                       "half-cylinder held at its flat face is R); its tangential compliance replaces "
+                                       "the half-space's datum; omitted: a half-space", None, plausible=LENGTH_RANGE,
+                             example="6 mm")},
     "ball_on_flat": {
         "radius": Key("length", "ball radius R (Eq. 10)", REQUIRED, plausible=LENGTH_RANGE, example="6 mm")},
     "crossed_cylinders": {

@@ -90,6 +90,11 @@ class Geometry:
     def extra_compliance(self, grid: Grid, youngs_modulus: float, poissons_ratio: float):
         return None
 
+    def tangential_shapes(self, strip_half_width: float) -> tuple:
+        """Each body's shape for its tangential compliance ((moving, stationary): None, a half-space) and the
+        loaded strip's half-width (mm)."""
+        return (None, None), strip_half_width
+
     @property
     def free_faces(self) -> tuple[tuple[str, float], ...]:
         return ()
@@ -126,6 +131,9 @@ class CylinderOnFlat(Geometry):
     radius: float
     length: float
     block_length: Optional[float] = None  # the flat's length along y when it ends in free faces (mm)
+    flat_width: Optional[float] = None  # the flat as a block W × T whose far face carries the stroke (mm)
+    flat_thickness: Optional[float] = None
+    moving_height: Optional[float] = None  # where the cylinder is held, above the contact (mm)
 
     @classmethod
     def from_case(cls, values: dict, fail) -> Optional["CylinderOnFlat"]:
@@ -135,7 +143,27 @@ class CylinderOnFlat(Geometry):
                                  f"({length!r} mm): its edges would cut into the contact, which fretsim does not "
                                  f"model; expected at least geometry.length")
             return None
+        width, thickness = values.get("flat_width"), values.get("flat_thickness")
+        if (width is None) != (thickness is None):
+            given, missing = ("flat_width", "flat_thickness") if thickness is None else ("flat_thickness", "flat_width")
+            fail(missing, f"missing: geometry.{given} makes the flat a block, which needs both its width and its "
+                          f"thickness (or neither: a half-space)")
+            return None
+        height, radius = values.get("moving_height"), values["radius"]
+        if height is not None and height > radius * (1 + 1e-9):
+            fail("moving_height", f"{height!r} mm is above the cylinder's radius {radius!r} mm: fretsim models the "
+                                  f"moving body as the cylinder's segment up to where it is held; expected at most "
+                                  f"geometry.radius (a half-cylinder held at its flat face: the radius)")
+            return None
         return cls(**values)
+
+    def tangential_shapes(self, strip_half_width: float) -> tuple:
+        """Each body's shape for its tangential compliance ((moving, stationary), None for a half-space) and the
+        loaded strip's half-width (mm)."""
+        from fretsim.compliance import bodies
+        moving = bodies.cylinder(self.radius, self.moving_height, strip_half_width) if self.moving_height else None
+        flat = bodies.block(self.flat_width, self.flat_thickness) if self.flat_width else None
+        return (moving, flat), strip_half_width
 
     @property
     def line_length(self) -> float:

@@ -12,12 +12,14 @@ from typing import Optional
 
 from fretsim import cycle as family
 from fretsim.case import Case, CaseError
+from fretsim.compliance import bodies
 from fretsim.compliance.tangential import Tangential
 from fretsim.cycle import CYCLES, STROKES
 from fretsim.cycle.coulomb import gross_slip_stroke
 from fretsim.grid import Grid
 from fretsim.loading import Block
 from fretsim.plan.choices import Choice, Plan
+from fretsim.reference import effective_modulus
 from fretsim.reference.mindlin import dundurs_beta
 from fretsim.solvers import solve
 
@@ -49,7 +51,18 @@ def tangential_operator(case: Case, grid: Grid):
     k_t = case.loading.tangential_stiffness
     rig = grid.area * volume_factor / k_t if k_t else 0.0
     bodies = [(m.youngs_modulus, m.poissons_ratio) for m in (case.moving, case.stationary)]
-    return Tangential(grid, bodies, case.geometry.line_length if plane else None, rig)
+    return Tangential(grid, bodies, case.geometry.line_length if plane or any(datums(case)) else None, rig,
+                      datums=datums(case))
+
+
+def datums(case: Case) -> tuple:
+    """Each body's datum distance (mm) from its shape (geometry.flat_width/flat_thickness, moving_height), None
+    where it is a half-space: the loaded strip taken as the unworn contact at the peak load."""
+    e_star = effective_modulus(case.moving.youngs_modulus, case.moving.poissons_ratio,
+                               case.stationary.youngs_modulus, case.stationary.poissons_ratio)
+    shapes, strip = case.geometry.tangential_shapes(case.geometry.hertz(case.loading.peak_load, e_star).half_width_x)
+    return tuple(None if shape is None else bodies.datum(shape, m.youngs_modulus, m.poissons_ratio, strip)
+                 for shape, m in zip(shapes, (case.moving, case.stationary)))
 
 
 def grid_load(case: Case, grid: Grid, normal_load: float) -> float:
