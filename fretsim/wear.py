@@ -181,6 +181,31 @@ def _sweep_shares(start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "
         yield target, share, (target >= 0) & (target < nx) & (share > 0)
 
 
+class Sweep:
+    """The shares of one travel (each element j of the moving body from x_j + start[j] to x_j + end[j], mm),
+    computed once for the several fields deposited and read along it (:func:`sweep_deposit`, :func:`sweep_read`)."""
+
+    def __init__(self, start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box"):
+        self.shape = start.shape
+        self.shares = list(_sweep_shares(start, end, dx, kernel))
+
+    def deposit(self, amount: np.ndarray) -> np.ndarray:
+        ny, nx = self.shape
+        rows = np.arange(ny)[:, None] * nx
+        out = np.zeros(amount.size)
+        for target, share, inside in self.shares:
+            out += np.bincount((rows + target)[inside], weights=(amount * share)[inside], minlength=amount.size)
+        return out.reshape(ny, nx)
+
+    def read(self, field: np.ndarray) -> np.ndarray:
+        ny, nx = field.shape
+        rows = np.arange(ny)[:, None]
+        out = np.zeros(field.shape)
+        for target, share, inside in self.shares:
+            out += np.where(inside, field[rows, np.clip(target, 0, nx - 1)] * share, 0.0)
+        return out
+
+
 def sweep_deposit(amount: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box") -> np.ndarray:
     """What the flat receives when each element j of the moving body carries ``amount[j]`` along its travel from
     x_j + start[j] to x_j + end[j] (mm, relative to its own centre), spread evenly over the travel.
@@ -190,12 +215,7 @@ def sweep_deposit(amount: np.ndarray, start: np.ndarray, end: np.ndarray, dx: fl
     the same [−δ, δ] it is the stroke average :func:`stroke_average` times the amount — the generalisation of
     Eqs. 15–16 to slip that differs from point to point.  Rows (axis 0) are independent; arrays (My, Mx).
     """
-    ny, nx = amount.shape
-    rows = np.arange(ny)[:, None] * nx
-    out = np.zeros(amount.size)
-    for target, share, inside in _sweep_shares(start, end, dx, kernel):
-        out += np.bincount((rows + target)[inside], weights=(amount * share)[inside], minlength=amount.size)
-    return out.reshape(ny, nx)
+    return Sweep(start, end, dx, kernel).deposit(amount)
 
 
 def sweep_read(field: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box") -> np.ndarray:
@@ -203,9 +223,5 @@ def sweep_read(field: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float,
     x_j + end[j]: the travel-weighted average, 0 beyond the grid (unworn).  The adjoint of :func:`sweep_deposit`
     (same shares), which keeps the resolved cycle's wear modes decaying: a read that is not the deposit's
     adjoint (interpolation at the travel's midpoint, say) lets short wear modes of the moving body grow."""
-    ny, nx = field.shape
-    rows = np.arange(ny)[:, None]
-    out = np.zeros(field.shape)
-    for target, share, inside in _sweep_shares(start, end, dx, kernel):
-        out += np.where(inside, field[rows, np.clip(target, 0, nx - 1)] * share, 0.0)
-    return out
+    return Sweep(start, end, dx, kernel).read(field)
+

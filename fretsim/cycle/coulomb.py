@@ -46,7 +46,7 @@ from fretsim.compliance import scaled
 from fretsim.cycle.result import Cycle, CycleError, CycleSpec, stick_half_width
 from fretsim.grid import Grid
 from fretsim.solvers.tangential import solve_tangential
-from fretsim.wear import gap_wear, sweep_deposit, sweep_read, wear_operator
+from fretsim.wear import Sweep, gap_wear, sweep_read, wear_operator
 from fretsim.wear_laws import WEAR_LAWS, WearLaw, coefficients
 
 CORRECTIONS = 1  # fixed-point corrections of an implicit step's gap for the wear its cycle really found: the
@@ -238,8 +238,18 @@ class CoulombCycle:
         """One increment with the normal contact solved where the moving body is: each of its points over the worn
         flat at the travel predicted from the last increment, solved again where a point went elsewhere."""
         dx = self.grid.dx
-        same_way = ds_prev is not None and du * du_prev > 0 and not self.rigid
-        ds_guess = ds_prev * (du / du_prev) if same_way else np.full(self.grid.shape, du)
+        if p_prev is not None and not self.rigid:
+            # where each point goes if the pressure stayed as it was: a tangential solve (about a quarter of a
+            # normal one) foresees the elastic take-up after a reversal, which scaling the last increment's slips
+            # did not, and points about to enter the contact go as their nearest neighbour in it (they had no slip
+            # of their own).  The travel then missed by 0.1 element in 3 % of the increments, not 63 %: the
+            # normal contact is solved about once per increment, not 1.6 times (McColl 185 N 2D: 1.5× faster)
+            _, ds_guess, _, its = self._tangential(q, p_prev, du)
+            tally.iterations += its
+            ds_guess = _nearest_in_contact(ds_guess, p_prev > 0)
+        else:
+            same_way = ds_prev is not None and du * du_prev > 0 and not self.rigid
+            ds_guess = ds_prev * (du / du_prev) if same_way else np.full(self.grid.shape, du)
         p, res = normal(wear_moving + sweep_read(wear_stationary, s, s + ds_guess, dx, self.kernel), p_prev, extra,
                         load=self.load, cycle=cycle)
         tally.iterations += res.iterations
@@ -314,13 +324,13 @@ class _Tally:
     def add(self, member: "CoulombCycle", p, q_new, s, ds, share: float) -> None:
         """One counted increment, ``share`` of the cycle's rig travel: the moving body wears at its own points, the
         flat where each point travelled; the flat's pressure is averaged over the rig's travel."""
-        dx, kernel = member.grid.dx, member.kernel
+        sweep = Sweep(s, s + ds, member.grid.dx, member.kernel)  # one travel, three fields along it
         amount = member.law.amount(p, q_new, ds)
         self.rate_m += member.k_moving * amount
-        self.rate_s += member.k_stationary * sweep_deposit(amount, s, s + ds, dx, kernel)
+        self.rate_s += member.k_stationary * sweep.deposit(amount)
         self.slip_m += np.abs(ds)
-        self.slip_s += sweep_deposit(np.abs(ds), s, s + ds, dx, kernel)
-        self.p_seen += share * sweep_deposit(p, s, s + ds, dx, kernel)
+        self.slip_s += sweep.deposit(np.abs(ds))
+        self.p_seen += share * sweep.deposit(p)
         self.energy += float((np.abs(q_new) * np.abs(ds)).sum()) * self.area
         self.work += float(amount.sum()) * self.area
         self.shear = np.maximum(self.shear, np.abs(q_new))
@@ -340,6 +350,20 @@ class _Tally:
             iterations=self.iterations, loop=(np.array(self.loop_u), np.array(self.loop_q)),
             memory={"slip_lin": max(s_max, 1e-300), "slip_spread": 1.0 - s_mean / s_max if s_max > 0 else 1.0},
             defect=defect, mismatch=mismatch, stick=stick_end if stick_end.any() else None)
+
+
+def _nearest_in_contact(values: np.ndarray, on: np.ndarray) -> np.ndarray:
+    """``values`` outside the contact ``on`` replaced, row by row, by the nearest value inside it along x."""
+    out = values.copy()
+    nx = values.shape[1]
+    idx = np.arange(nx)
+    for r in np.flatnonzero(on.any(axis=1)):
+        inside = np.flatnonzero(on[r])
+        nearest = inside[np.clip(np.searchsorted(inside, idx), 0, inside.size - 1)]
+        left = inside[np.clip(np.searchsorted(inside, idx) - 1, 0, inside.size - 1)]
+        nearest = np.where(np.abs(idx - left) <= np.abs(idx - nearest), left, nearest)
+        out[r] = values[r, nearest]
+    return out
 
 
 def _span(mask: np.ndarray) -> slice:
