@@ -238,17 +238,22 @@ class CoulombCycle:
         """One increment with the normal contact solved where the moving body is: each of its points over the worn
         flat at the travel predicted from the last increment, solved again where a point went elsewhere."""
         dx = self.grid.dx
-        if p_prev is not None and not self.rigid:
-            # where each point goes if the pressure stayed as it was: a tangential solve (about a quarter of a
-            # normal one) foresees the elastic take-up after a reversal, which scaling the last increment's slips
-            # did not, and points about to enter the contact go as their nearest neighbour in it (they had no slip
-            # of their own).  The travel then missed by 0.1 element in 3 % of the increments, not 63 %: the
-            # normal contact is solved about once per increment, not 1.6 times (McColl 185 N 2D: 1.5× faster)
+        same_way = ds_prev is not None and du * du_prev > 0 and not self.rigid
+        on = p_prev > 0 if p_prev is not None else None
+        if same_way and np.abs(ds_prev[on] - du_prev).max(initial=0.0) < TRAVEL_TOLERANCE * dx:
+            # the last increment slid the whole contact with the rig: this one will too (gross slip far from a
+            # reversal, most increments); points about to enter the contact go as their nearest neighbour in it
+            ds_guess = _nearest_in_contact(ds_prev * (du / du_prev), on)
+        elif p_prev is not None and not self.rigid:
+            # near a reversal, or in partial slip: where each point goes if the pressure stayed as it was, from a
+            # tangential solve (about a quarter of a normal one in 2D), which foresees the elastic take-up that
+            # scaling the last increment's slips missed by most of an element.  With both, the travel misses by
+            # 0.1 element in 2.5 % of the increments, not 63 %: the normal contact is solved about once per
+            # increment, not 1.6 times (McColl 185 N 2D: 4735 → 3279 normal solves)
             _, ds_guess, _, its = self._tangential(q, p_prev, du)
             tally.iterations += its
-            ds_guess = _nearest_in_contact(ds_guess, p_prev > 0)
+            ds_guess = _nearest_in_contact(ds_guess, on)
         else:
-            same_way = ds_prev is not None and du * du_prev > 0 and not self.rigid
             ds_guess = ds_prev * (du / du_prev) if same_way else np.full(self.grid.shape, du)
         p, res = normal(wear_moving + sweep_read(wear_stationary, s, s + ds_guess, dx, self.kernel), p_prev, extra,
                         load=self.load, cycle=cycle)
