@@ -10,7 +10,9 @@
    the pressure changes along it and the increments are a quadrature — the chart shows the depth error against
    the loop time (McColl 500 N, 2D, against 65 increments).
 
-    python scripts/bench_friction.py [--quick] [--vs OLD_TREE [--vs-only]]
+    python scripts/bench_friction.py [--quick] [--vs OLD_TREE [--vs-only] [--resolved]]
+
+``--resolved`` adds the resolved stroke (2D and 3D, 3 pairs each) to the pairs against the old tree.
 
 Prints tables; writes scripts/out/bench_friction.{txt,csv,png}.
 """
@@ -44,14 +46,19 @@ def loop_seconds(tree: str, case: str, overrides: list[str]) -> float:
 
 VERSUS = (("uniform, 3D", []), ("coulomb (mid-stroke), 2D", [MU, "model.slip=coulomb", "model.dimension=2d"]),
           ("coulomb (mid-stroke), 3D", [MU, "model.slip=coulomb", "model.dimension=3d"]))
+# with --resolved: the resolved stroke too, 3 pairs (a 3D pair takes about 3 minutes)
+RESOLVED = (("coulomb (resolved), 2D", [MU, "model.slip=coulomb", "model.stroke=resolved", "model.dimension=2d",
+                                        "grid.error_estimate=none"]),
+            ("coulomb (resolved), 3D", [MU, "model.slip=coulomb", "model.stroke=resolved", "model.dimension=3d",
+                                        "grid.error_estimate=none"]))
 
 
-def versus(baseline: str, pairs: int, say: Report, rows: list) -> None:
+def versus(baseline: str, pairs: int, say: Report, rows: list, models=VERSUS) -> None:
     """This tree's loop time over the baseline's, pair by pair (each pair run back to back, this tree first)."""
     case = str(ROOT / "cases" / "mccoll_185N.yaml")
     say(f"the loop against {baseline}: McColl 185 N, 18 000 cycles, {pairs} pairs each (fresh processes)")
     say(f"{'model':<28}{'this s':>9}{'old s':>9}{'ratio':>8}{'min':>7}{'max':>7}")
-    for label, sets in VERSUS:
+    for label, sets in models:
         ratios, a_s, b_s = [], [], []
         for _ in range(pairs):
             a, b = loop_seconds(str(ROOT), case, sets), loop_seconds(baseline, case, sets)
@@ -62,12 +69,14 @@ def versus(baseline: str, pairs: int, say: Report, rows: list) -> None:
                      "ratio_median": float(np.median(ratios)), "ratio_min": min(ratios), "ratio_max": max(ratios)})
 
 
-def main(quick: bool = False, baseline: str = "", vs_only: bool = False) -> None:
+def main(quick: bool = False, baseline: str = "", vs_only: bool = False, resolved: bool = False) -> None:
     say = Report()
     rows = []
     case = str(ROOT / "cases" / "mccoll_185N.yaml")
     if baseline:
         versus(baseline, 3 if quick else 7, say, rows)
+        if resolved:
+            versus(baseline, 3, say, rows, RESOLVED)
         if vs_only:
             OUT.mkdir(parents=True, exist_ok=True)
             say.write(OUT / "bench_friction_vs.txt")
@@ -136,4 +145,4 @@ def main(quick: bool = False, baseline: str = "", vs_only: bool = False) -> None
 if __name__ == "__main__":
     args = sys.argv[1:]
     vs = args[args.index("--vs") + 1] if "--vs" in args else os.environ.get("FRETSIM_BASELINE", "")
-    main("--quick" in args, vs, "--vs-only" in args)
+    main("--quick" in args, vs, "--vs-only" in args, "--resolved" in args)
