@@ -95,6 +95,9 @@ class Geometry:
         loaded strip's half-width (mm)."""
         return (None, None), strip_half_width
 
+    def shape_sizes(self) -> list:
+        return []
+
     @property
     def free_faces(self) -> tuple[tuple[str, float], ...]:
         return ()
@@ -156,6 +159,11 @@ class CylinderOnFlat(Geometry):
                                   f"geometry.radius (a half-cylinder held at its flat face: the radius)")
             return None
         return cls(**values)
+
+    def shape_sizes(self) -> list:
+        """(case key, mm) of each given size of the bodies' shapes."""
+        return [(f"geometry.{k}", getattr(self, k)) for k in ("flat_width", "flat_thickness", "moving_height")
+                if getattr(self, k) is not None]
 
     def tangential_shapes(self, strip_half_width: float) -> tuple:
         """Each body's shape for its tangential compliance ((moving, stationary), None for a half-space) and the

@@ -126,3 +126,19 @@ def test_shapes_are_refused_where_the_geometry_has_no_such_bodies():
     with pytest.raises(CaseError) as info:
         load_case(CASES / "ball_partial_slip.yaml", ["geometry.flat_width=12 mm"])
     assert "geometry.flat_width" in str(info.value)
+
+
+@pytest.mark.parametrize("key, value", [("geometry.moving_height", "0.001 mm"), ("geometry.flat_width", "0.1 mm")])
+def test_a_body_not_much_larger_than_its_contact_is_refused_with_the_size_it_needs(key, value):
+    """The datum rests on the body being much larger than its contact (the strip test above); a 0.1 mm flat under
+    a 72 µm contact overflowed the datum (a traceback) before this was refused, by key, with the least size."""
+    extra = ["geometry.flat_thickness=6 mm"] if key == "geometry.flat_width" else []
+    with pytest.raises(CaseError) as info:
+        prepare(load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", *COULOMB, f"{key}={value}", *extra]))
+    text = str(info.value)
+    assert key in text and "expected at least 0.717 mm" in text  # 10× the unworn contact's width, 71.7 µm
+
+
+def test_shapes_without_friction_are_said_to_play_no_part():
+    setup, _, plan = prepare(load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", *SHAPES]))
+    assert any("plays no part" in w and "geometry.flat_width" in w for w in plan.warnings)

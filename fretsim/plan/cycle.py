@@ -61,8 +61,19 @@ def datums(case: Case) -> tuple:
     e_star = effective_modulus(case.moving.youngs_modulus, case.moving.poissons_ratio,
                                case.stationary.youngs_modulus, case.stationary.poissons_ratio)
     shapes, strip = case.geometry.tangential_shapes(case.geometry.hertz(case.loading.peak_load, e_star).half_width_x)
+    problems = [(key, f"{value * 1e3:.4g} µm is less than {SHAPE_TO_CONTACT:g}× the contact's width "
+                      f"{2e3 * strip:.4g} µm (at {case.loading.peak_load:.4g} N): the body's share of the stroke is "
+                      f"modelled as a half-plane's near the contact with the rest of the body adding a uniform "
+                      f"displacement, which holds for a body much larger than its contact; expected at least "
+                      f"{SHAPE_TO_CONTACT * 2 * strip:.3g} mm, or leave the shape out (a half-space)")
+                for key, value in case.geometry.shape_sizes() if value < SHAPE_TO_CONTACT * 2 * strip]
+    if problems:
+        raise CaseError(case.source, problems)
     return tuple(None if shape is None else bodies.datum(shape, m.youngs_modulus, m.poissons_ratio, strip)
                  for shape, m in zip(shapes, (case.moving, case.stationary)))
+
+
+SHAPE_TO_CONTACT = 10  # a body's sizes over its contact's width: the datum then moves by < 1 % with the strip
 
 
 def grid_load(case: Case, grid: Grid, normal_load: float) -> float:
@@ -158,6 +169,11 @@ def build(case: Case, plan: Plan, grids, model, regime_: Regime) -> Cycles:
             increments=case.increments, volume_factor=case.geometry.line_length if grid.plane_strain else 1.0))
 
     members = tuple(built.setdefault(b, member(b)) for b in case.loading.blocks)
+    shapes = [key for key, _ in case.geometry.shape_sizes()]
+    if shapes and not CYCLES[slip].needs_friction:
+        plan.warnings.append(f"{', '.join(shapes)} given, but the {slip} cycle has every point slide with the rig: "
+                             f"the bodies' tangential compliance, which their shapes set, plays no part (give "
+                             f"loading.friction_coefficient and model.slip: {family.FRICTION})")
     if not members[0].linear:
         _check_incremental(case, grids, model, plan, regime_.transition)
     if STROKES[stroke_model]:
@@ -193,8 +209,9 @@ def _warn_resolved(case: Case, plan: Plan) -> None:
                                                  "flat's wear under it", case.gap_model != "auto"))
     plan.warnings.append("model.stroke resolved: the worn profiles develop kinks where the contact's edges "
                          "turn at the stroke's ends, with pressure peaks there that grow as the grid is "
-                         "refined (the depths and widths settle; the peak pressure does not), and the "
-                         "depths move with the step size by a few per cent (README: the resolved stroke)")
+                         "refined, and its depths and widths move by a few per cent with the increments, the "
+                         "grid and the step size: not converged, for studies only (README: the resolved "
+                         "stroke; scripts/results/resolved_convergence.txt)")
     if case.increments < 5:
         plan.warnings.append(f"model.increments {case.increments} with the stroke resolved: the contact "
                              f"is solved at only {case.increments} position(s) per half-stroke, so each "
