@@ -354,6 +354,27 @@ def test_the_recorded_loops_elastic_side_spans_what_a_finely_stepped_loop_does(f
     assert np.abs(f[top:] - at).max() < 0.02 * mu * 185.0  # the fine loop's own interpolation error, side curvature
 
 
+@pytest.mark.parametrize("factor", [1.5, 6.0])
+def test_a_resolved_strokes_recorded_loop_spans_its_side_as_a_finely_stepped_resolved_loop_does(factor):
+    """The resolved stroke's wear increments are a quadrature along the stroke (9 evenly spaced by default): the
+    loop they drew had sides an increment wide.  Its recorded loop is drawn from each turning point on the
+    pressure there, the side finely cut; it must span the side as the loop of 201 increments per half-stroke
+    (the pressure solved at every one) does, within 10 %."""
+    grid, c, k, normal, a = ball_contact(32)
+    mu = 0.6
+    stroke = factor * M.ball_gross_slip_displacement(mu, 185.0, a, BODIES)
+    zero = np.zeros(grid.shape)
+    recorded = fretting_cycle(grid, c, k, stroke, 185.0, mu, resolved=True).solve(zero, zero, normal, None)
+    fine = fretting_cycle(grid, c, k, stroke, 185.0, mu, resolved=True, increments=201).solve(
+        zero, zero, normal, None, detail=False)  # not a recorded state: the loop of its own increments
+    assert recorded.regime == fine.regime == "gross_slip"
+    assert _side_um(*recorded.loop) == pytest.approx(_side_um(*fine.loop), rel=0.10)
+    if factor > 5:  # the loop of the 9 wear increments themselves (what was recorded before): far off here
+        evenly = fretting_cycle(grid, c, k, stroke, 185.0, mu, resolved=True).solve(zero, zero, normal, None,
+                                                                                   detail=False)
+        assert abs(_side_um(*evenly.loop) / _side_um(*fine.loop) - 1) > 0.2
+
+
 # --- whole runs ---------------------------------------------------------------------------------------------------
 
 CASES = __import__("pathlib").Path(__file__).resolve().parents[1] / "cases"

@@ -43,6 +43,7 @@ from typing import Optional
 import numpy as np
 
 from fretsim.compliance import scaled
+from fretsim.cycle.loop import LOOP_SIDE_INCREMENTS, elastic_side, loop_path, turning_loop
 from fretsim.cycle.result import Cycle, CycleError, CycleSpec, stick_half_width
 from fretsim.grid import Grid
 from fretsim.solvers.tangential import solve_tangential
@@ -55,8 +56,6 @@ CORRECTIONS = 1  # fixed-point corrections of an implicit step's gap for the wea
 SPREAD_TO_CORRECT = 0.1  # ... where the slip varies by more than this share of its largest (1 − mean/max): in gross
 #                         slip far above δ_t every point slides nearly alike, the linearisation is nearly exact
 #                         (McColl 185 N: 1e-5 without the correction) and the correction would cost 1.5× the time
-LOOP_SIDE_INCREMENTS = 12  # increments over the fretting loop's elastic side at a recorded state (mid-stroke): the
-#                          side ends on an increment, so its span is exact; 12 draw Mindlin's curve to ~1 % of Q*
 TRAVEL_TOLERANCE = 0.1  # of an element: a resolved increment is solved again where a point's predicted travel was off
 #                         by more (the pressure follows the worn flat on that scale)
 
@@ -149,29 +148,8 @@ class CoulombCycle:
         down = [(d - 2 * d * k / n, d - 2 * d * (k + 1) / n, True) for k in range(n)]
         return quarter + up + down
 
-    def loop_path(self, side: float) -> list[tuple[float, float, bool]]:
-        """The increments of a recorded cycle with the pressure fixed: each half-stroke's elastic side, the first
-        ``side`` (mm) of rig travel after a reversal, in LOOP_SIDE_INCREMENTS (or model.increments) equal parts, the rest (sliding at
-        ±μP, a straight line) in one.  With the pressure fixed a monotone half-stroke's wear does not depend on
-        how it is cut (each point slips one way), so this changes the loop's shape, not the wear: evenly spaced
-        increments (2δ/9 each) slid the whole contact in the first increment after reversal and drew the sides
-        several times wider than 2δ_t."""
-        d = self.stroke
-        side = min(max(side, 0.0), 2.0 * d)
-        m = max(LOOP_SIDE_INCREMENTS, self.increments)  # model.increments asks for a finer loop, never coarser
-        offsets = [side * k / m for k in range(m + 1)] + ([2.0 * d] if side < 2.0 * d * (1 - 1e-9) else [])
-        offsets[-1] = 2.0 * d  # the turning point exactly, whatever the rounding
-        up = [(-d + a, -d + b, True) for a, b in zip(offsets[:-1], offsets[1:])]
-        down = [(d - a, d - b, True) for a, b in zip(offsets[:-1], offsets[1:])]
-        return [(0.0, -d, False)] + up + down
-
-    def elastic_side(self, pressure: np.ndarray) -> float:
-        """2δ_t over the whole contact (mm): the rig travel after a reversal before the last point slides again
-        (Masing: twice the first loading's), where the loop's side ends; 2δ where it never does (partial slip)."""
-        on = pressure > 0
-        if self.rigid or not on.any():
-            return 0.0
-        return 2.0 * float(self.tangential(self.friction_coefficient * pressure)[on].max())
+    def _elastic_side(self, pressure: np.ndarray) -> float:
+        return 0.0 if self.rigid else elastic_side(self.tangential, self.friction_coefficient, pressure)
 
     def solve(self, wear_moving, wear_stationary, normal, guess, step: float = 0.0, memory=None,
               cycle: int = 0, detail: bool = True) -> Cycle:
@@ -201,8 +179,9 @@ class CoulombCycle:
             fixed = normal(seen, guess, extra, load=self.load, cycle=cycle)
         tally = _Tally(shape, self.grid.area * self.volume_factor)
         q, s = np.zeros(shape), np.zeros(shape)
-        path = (self.loop_path(self.elastic_side(fixed[0])) if detail and not self.resolved and not self.rigid
-                else self.path(n))
+        fine = max(LOOP_SIDE_INCREMENTS, self.increments)  # model.increments asks for a finer loop, never coarser
+        path = (loop_path(self.stroke, self._elastic_side(fixed[0]), fine) if detail and not self.resolved
+                and not self.rigid else self.path(n))
         first = next(k for k, step in enumerate(path) if step[2])  # the loop's first increment (after the quarter)
         # the increment over U = 0 going up (centred on it for the resolved stroke's odd count); the up-stroke's end
         mid = next(k for k in range(first, len(path)) if path[k][0] < 0.0 <= path[k][1])
@@ -211,6 +190,7 @@ class CoulombCycle:
         for k, (u0, u1, counted) in enumerate(path):
             if k == first:
                 tally.loop(u0, q)
+                q_low, p_low = q, p_prev
             du = u1 - u0
             if self.resolved:
                 p, res, q_new, ds, stuck = self._resolved_increment(wear_moving, wear_stationary, normal, q, s, du,
@@ -225,8 +205,13 @@ class CoulombCycle:
                 p_mid, res_mid, travel_mid = p, res, (s, s + ds)
             if k == end:
                 stick_end = stuck & (p > 0)
+                q_high, p_high = q_new, p
             s, q = s + ds, q_new
             p_prev, ds_prev, du_prev = p, ds, du
+        if self.resolved and detail and not self.rigid:
+            tally.loop_u, tally.loop_q = turning_loop(self.stroke, max(LOOP_SIDE_INCREMENTS, self.increments),
+                                                      self._tangential, self._elastic_side, (q_low, p_low),
+                                                      (q_high, p_high), tally.area)
         defect, mismatch = 0.0, None
         if step:
             defect, mismatch = self._defect(wear_moving, wear_stationary, step, w_lin, tally, p_mid, travel_mid,
