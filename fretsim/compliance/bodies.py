@@ -30,8 +30,6 @@ import math
 from dataclasses import dataclass
 from functools import lru_cache
 import numpy as np
-import scipy.sparse as sp
-import scipy.sparse.linalg as spla
 
 STRIP_ELEMENTS = 16  # elements across each half of the loaded strip
 GROWTH = 1.1  # largest ratio of neighbouring element sizes away from the strip
@@ -107,6 +105,7 @@ def _mesh(body: Body, a: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, int
 
 def _stiffness(nodes: np.ndarray, elements: np.ndarray, youngs_modulus: float, poissons_ratio: float):
     """The plane-strain stiffness matrix of bilinear quadrilaterals (2 × 2 Gauss points)."""
+    import scipy.sparse as sp  # here, not at the top: planning a case without shapes must not load scipy.linalg
     e, nu = youngs_modulus, poissons_ratio
     d = e / ((1 + nu) * (1 - 2 * nu)) * np.array([[1 - nu, nu, 0], [nu, 1 - nu, 0], [0, 0, (1 - 2 * nu) / 2]])
     g = 1.0 / math.sqrt(3.0)
@@ -133,6 +132,7 @@ def _stiffness(nodes: np.ndarray, elements: np.ndarray, youngs_modulus: float, p
 def strip_displacement(body: Body, youngs_modulus: float, poissons_ratio: float, strip_half_width: float) -> float:
     """ū (mm per N/mm): the mean x-displacement of the strip |x| ≤ a at y = 0 under a unit tangential force per
     unit length spread evenly over it, relative to the held face."""
+    import scipy.sparse.linalg as spla
     a = strip_half_width
     nodes, elements, strip, nx = _mesh(body, a)
     k = _stiffness(nodes, elements, youngs_modulus, poissons_ratio)
