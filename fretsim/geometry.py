@@ -126,6 +126,10 @@ def _line_gap(grid: Grid, radius: float, length: float, drop: Optional[np.ndarra
     return np.where(np.abs(Y) <= length / 2.0 + 1e-12 * length, gap, np.inf)
 
 
+MAX_BLOCK_ASPECT = 2.0  # the bodies' solve checked against an independent one over this range (tests/test_bodies.py)
+MAX_CYLINDER_RATIO = 10.0
+
+
 @dataclass(frozen=True)
 class CylinderOnFlat(Geometry):
     """A cylinder of radius R and length L, axis along y, on a flat (paper Eq. 9)."""
@@ -152,7 +156,18 @@ class CylinderOnFlat(Geometry):
             fail(missing, f"missing: geometry.{given} makes the flat a block, which needs both its width and its "
                           f"thickness (or neither: a half-space)")
             return None
+        if width is not None and thickness > MAX_BLOCK_ASPECT * width * (1 + 1e-9):
+            fail("flat_thickness", f"{thickness!r} mm is more than {MAX_BLOCK_ASPECT:g}× the block's width {width!r} "
+                                   f"mm: a block that slender bends under the shear, which the bodies' solve "
+                                   f"(bilinear elements) models too stiffly; verified up to thickness "
+                                   f"{MAX_BLOCK_ASPECT:g}× the width (README: the bodies' share of the stroke)")
+            return None
         height, radius = values.get("moving_height"), values["radius"]
+        if height is not None and height < radius / MAX_CYLINDER_RATIO * (1 - 1e-9):
+            fail("moving_height", f"{height!r} mm is less than a {MAX_CYLINDER_RATIO:g}th of the radius {radius!r} mm: "
+                                  f"a cylinder held that close to its contact is a thin slice, which the bodies' "
+                                  f"solve models too stiffly; verified from R/{MAX_CYLINDER_RATIO:g} to R")
+            return None
         if height is not None and height > radius * (1 + 1e-9):
             fail("moving_height", f"{height!r} mm is above the cylinder's radius {radius!r} mm: fretsim models the "
                                   f"moving body as the cylinder's segment up to where it is held; expected at most "

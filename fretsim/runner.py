@@ -17,7 +17,7 @@ import numpy as np
 from fretsim import grid_error
 from fretsim.case import GEOMETRY_KEYS, Case, CaseError, parse_case
 from fretsim.plan import Plan, SideRuns, estimate_cost, prepare
-from fretsim.plan.cycle import datums
+from fretsim.plan.cycle import strip_compliances
 from fretsim.reference import effective_modulus
 from fretsim.results import (OutputBusy, OutputClaim, Results, ResultsIOError, ResultsWriter, check_output_path,
                              read_results)
@@ -100,10 +100,12 @@ def inputs_of(case: Case) -> dict:
         values["friction_coefficient"] = (loading.friction_coefficient, "1", "friction coefficient")
     if loading.tangential_stiffness is not None:
         values["tangential_stiffness"] = (loading.tangential_stiffness * 1e-3, "N/um", "the rig's tangential stiffness")
-    for body, d in zip(("moving", "stationary"), datums(case) if loading.friction_coefficient is not None else ()):
-        if d is not None:
-            values[f"tangential_datum_{body}"] = (d, "mm", f"the {body} body's datum from its shape: the half-plane "
-                                                            f"referred to it takes up the stroke as the body does")
+    for body, u in zip(("moving", "stationary"),
+                       strip_compliances(case) if loading.friction_coefficient is not None else ()):
+        if u is not None:
+            values[f"tangential_compliance_{body}"] = (u * 1e3, "um/(N/mm)", f"the {body} body's tangential "
+                                                       f"compliance from its shape: the contact strip's mean "
+                                                       f"displacement per unit force per unit length")
     e_star = effective_modulus(case.moving.youngs_modulus, case.moving.poissons_ratio,
                                case.stationary.youngs_modulus, case.stationary.poissons_ratio)
     h = g.hertz(loading.peak_load, e_star)

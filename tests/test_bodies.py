@@ -66,6 +66,22 @@ def test_the_bodies_strip_displacement_matches_an_independent_finite_element_sol
     assert mine == pytest.approx(_skfem_strip_displacement(body, a), rel=0.01)
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("shape", ["block 12 x 24", "block 48 x 6", "cylinder R 20 held 2", "cylinder R 6 held 1"])
+def test_at_the_edges_of_the_accepted_shapes_the_strip_displacement_is_within_five_percent(shape):
+    """The accepted range (geometry.py: a block at most twice as thick as wide, a cylinder held between R/10 and R)
+    at a small strip (McColl's 185 N contact, a = 36 µm), where the Q4 mesh is coarsest against the body: measured
+    1.4 % (the slender block, which bends and which bilinear elements stiffen) and 4.0 % (R 20 held 2 mm: the
+    section widens within the first rows) below the P2 solution, converging at first order as the mesh is refined.
+    ū is the strip's whole displacement, the half-plane's log part included: 4 % of it moves δ_t by about 2 % and
+    the slip, so the wear, by about δ_t/δ of that."""
+    a = 0.0359
+    body = {"block 12 x 24": B.block(12.0, 24.0), "block 48 x 6": B.block(48.0, 6.0),
+            "cylinder R 20 held 2": B.cylinder(20.0, 2.0, a), "cylinder R 6 held 1": B.cylinder(6.0, 1.0, a)}[shape]
+    reference = _skfem_strip_displacement(body, a, per_half_strip=30, growth=1.08)
+    assert B.strip_displacement(body, E, NU, a) == pytest.approx(reference, rel=0.05)
+
+
 def test_a_bodys_datum_scales_with_its_size_and_hardly_depends_on_the_strip():
     """Elastic similarity: a block ten times larger, loaded on a strip ten times wider, has its datum ten times
     farther (to round-off, same mesh in proportion).  And the datum is the body's, not the strip's: halving the
@@ -115,6 +131,9 @@ def test_a_run_with_the_bodies_shapes_slides_less_and_keeps_its_invariant():
     (["geometry.flat_width=12 mm"], "geometry.flat_thickness", "needs both"),
     (["geometry.moving_height=7 mm"], "geometry.moving_height", "at most geometry.radius"),
     (["geometry.flat_width=-1 mm", "geometry.flat_thickness=6 mm"], "geometry.flat_width", ""),
+    # a tall block bent so far that its datum overflowed (a traceback) before the range was refused
+    (["geometry.flat_width=12 mm", "geometry.flat_thickness=60 mm"], "geometry.flat_thickness", "2× the width"),
+    (["geometry.moving_height=0.5 mm"], "geometry.moving_height", "from R/10 to R"),
 ])
 def test_shapes_that_do_not_make_a_body_are_refused_by_key(overrides, key, words):
     with pytest.raises(CaseError) as info:
@@ -128,11 +147,11 @@ def test_shapes_are_refused_where_the_geometry_has_no_such_bodies():
     assert "geometry.flat_width" in str(info.value)
 
 
-@pytest.mark.parametrize("key, value", [("geometry.moving_height", "0.001 mm"), ("geometry.flat_width", "0.1 mm")])
+@pytest.mark.parametrize("key, value", [("geometry.moving_height", "0.65 mm"), ("geometry.flat_width", "0.1 mm")])
 def test_a_body_not_much_larger_than_its_contact_is_refused_with_the_size_it_needs(key, value):
     """The datum rests on the body being much larger than its contact (the strip test above); a 0.1 mm flat under
     a 72 µm contact overflowed the datum (a traceback) before this was refused, by key, with the least size."""
-    extra = ["geometry.flat_thickness=6 mm"] if key == "geometry.flat_width" else []
+    extra = ["geometry.flat_thickness=0.2 mm"] if key == "geometry.flat_width" else []
     with pytest.raises(CaseError) as info:
         prepare(load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", *COULOMB, f"{key}={value}", *extra]))
     text = str(info.value)

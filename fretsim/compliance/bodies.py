@@ -7,7 +7,7 @@ finite body's displacement is the half-plane's (the log term, which sets stick a
 adds a displacement that is nearly uniform over a contact much smaller than the body.  So each body keeps the
 half-plane kernel and gets its own datum distance d, chosen so that the mean displacement of the loaded strip
 equals the finite body's, which a one-off plane-strain solve of the body gives: bilinear quadrilaterals on a
-mesh graded from the strip (elements a/8 there, growing by 1.2 at most), the held face fixed, the strip under a
+mesh graded from the strip (elements a/16 there, growing by 1.1 at most), the held face fixed, the strip under a
 uniform shear traction.  For the half-plane with datum d, a unit force per unit length spread over |x| ≤ a has
 the mean displacement (2/πE')·[ln(d/2a) + 3/2] (E' = E/(1 − ν²); the strip kernel's mean over the strip), so
 
@@ -153,8 +153,20 @@ def strip_displacement(body: Body, youngs_modulus: float, poissons_ratio: float,
 
 
 @lru_cache(maxsize=64)
-def datum(body: Body, youngs_modulus: float, poissons_ratio: float, strip_half_width: float) -> float:
-    """The 2D datum distance d (mm) at which the half-plane takes up the stroke as the finite ``body`` does."""
+def strip_compliance(body: Body, youngs_modulus: float, poissons_ratio: float, strip_half_width: float) -> float:
+    """:func:`strip_displacement`, kept per process (a sweep's points share their bodies)."""
+    return strip_displacement(body, youngs_modulus, poissons_ratio, strip_half_width)
+
+
+def log_datum(body: Body, youngs_modulus: float, poissons_ratio: float, strip_half_width: float) -> float:
+    """ln of the 2D datum distance d (mm) at which the half-plane takes up the stroke as the finite ``body`` does.
+    The kernel needs only ln d, and d itself overflows for a block that bends (a thickness several times its
+    width: ū grows as the cube of the ratio)."""
     e_plane = youngs_modulus / (1.0 - poissons_ratio ** 2)
-    u = strip_displacement(body, youngs_modulus, poissons_ratio, strip_half_width)
-    return 2.0 * strip_half_width * math.exp(math.pi * e_plane * u / 2.0 - 1.5)
+    u = strip_compliance(body, youngs_modulus, poissons_ratio, strip_half_width)
+    return math.log(2.0 * strip_half_width) + math.pi * e_plane * u / 2.0 - 1.5
+
+
+def datum(body: Body, youngs_modulus: float, poissons_ratio: float, strip_half_width: float) -> float:
+    """The 2D datum distance d (mm): exp(:func:`log_datum`)."""
+    return math.exp(log_datum(body, youngs_modulus, poissons_ratio, strip_half_width))

@@ -65,39 +65,39 @@ def datum_distance(length: float, poissons_ratio: float) -> float:
 
 
 def tangential_kernel(grid: Grid, bodies: Sequence[tuple[float, float]], line_length: Optional[float] = None,
-                      rig_compliance: float = 0.0, datums: Optional[Sequence[Optional[float]]] = None) -> np.ndarray:
+                      rig_compliance: float = 0.0, log_datums: Optional[Sequence[Optional[float]]] = None) -> np.ndarray:
     """Kernel (shape (2My − 1, 2Mx − 1)) of u_x per unit shear traction on one element, both bodies.
 
     ``bodies``: (E, ν) of each body (MPa).  2D needs ``line_length`` (the datum's L).  ``rig_compliance``: the
     displacement per unit traction on one element that the rig adds (A/k in 3D, L·dx/k in 2D), mm/MPa.
-    ``datums``: per body, the datum distance (mm) of a finite body held at a face (:mod:`.bodies`), or None for
-    the half-space's; in 3D (a line contact of length L) a finite body's datum d adds (2/πE'L)·ln(d/d_L) per unit
-    force, d_L the half-space's 2D datum, times the element's area.
+    ``log_datums``: per body, ln of the datum distance (mm) of a finite body held at a face (:mod:`.bodies`), or
+    None for the half-space's; in 3D (a line contact of length L) a finite body's datum d adds (2/πE'L)·ln(d/d_L)
+    per unit force, d_L the half-space's 2D datum, times the element's area.
     """
     ny, nx = grid.shape
     ox = (np.arange(2 * nx - 1) - (nx - 1)) * grid.dx
-    datums = tuple(datums) if datums is not None else (None,) * len(bodies)
+    log_datums = tuple(log_datums) if log_datums is not None else (None,) * len(bodies)
     if grid.plane_strain:
         if line_length is None:
             raise ValueError("a 2D tangential operator needs the contact length for its datum")
         kernel = np.zeros((1, 2 * nx - 1))
-        for (e, nu), shape_datum in zip(bodies, datums):
+        for (e, nu), log_d in zip(bodies, log_datums):
             e_body = e / (1.0 - nu * nu)  # this body's share of 1/E*
-            d = shape_datum if shape_datum is not None else datum_distance(line_length, nu)
+            log_d = log_d if log_d is not None else math.log(datum_distance(line_length, nu))
             # the strip kernel is referred to ln(1 mm) = 0; far away it is −(2/πE)·dx·(ln|x| + 1): refer it to d
             kernel += strip_plane_strain(ox, grid.dx / 2.0, e_body)[None, :]
-            kernel += 2.0 / (math.pi * e_body) * grid.dx * (math.log(d) + 1.0)
+            kernel += 2.0 / (math.pi * e_body) * grid.dx * (log_d + 1.0)
     else:
         oy = (np.arange(2 * ny - 1) - (ny - 1)) * grid.dy
         X, Y = np.meshgrid(ox, oy)
         kernel = sum(cerruti_rectangle(X, Y, grid.dx / 2.0, grid.dy / 2.0, e, nu) for e, nu in bodies)
-        for (e, nu), shape_datum in zip(bodies, datums):
-            if shape_datum is not None:
+        for (e, nu), log_d in zip(bodies, log_datums):
+            if log_d is not None:
                 if line_length is None:
                     raise ValueError("a finite body's datum in 3D needs a line contact's length")
                 e_body = e / (1.0 - nu * nu)
-                kernel = kernel + grid.area * 2.0 / (math.pi * e_body * line_length) * math.log(
-                    shape_datum / datum_distance(line_length, nu))
+                kernel = kernel + grid.area * 2.0 / (math.pi * e_body * line_length) * (
+                    log_d - math.log(datum_distance(line_length, nu)))
     return kernel + rig_compliance
 
 
@@ -106,13 +106,13 @@ class Tangential(Convolution):
 
     def __init__(self, grid: Grid, bodies: Sequence[tuple[float, float]], line_length: Optional[float] = None,
                  rig_compliance: float = 0.0, _kernel: Optional[np.ndarray] = None,
-                 datums: Optional[Sequence[Optional[float]]] = None):
+                 log_datums: Optional[Sequence[Optional[float]]] = None):
         self.bodies = tuple((float(e), float(nu)) for e, nu in bodies)
         self.line_length = line_length
         self.rig_compliance = float(rig_compliance)
-        self.datums = tuple(datums) if datums is not None else (None,) * len(self.bodies)
-        super().__init__(grid, tangential_kernel(grid, self.bodies, line_length, rig_compliance, self.datums)
+        self.log_datums = tuple(log_datums) if log_datums is not None else (None,) * len(self.bodies)
+        super().__init__(grid, tangential_kernel(grid, self.bodies, line_length, rig_compliance, self.log_datums)
                          if _kernel is None else _kernel)
 
     def _like(self, grid: Grid, kernel: np.ndarray) -> "Tangential":
-        return Tangential(grid, self.bodies, self.line_length, self.rig_compliance, kernel, self.datums)
+        return Tangential(grid, self.bodies, self.line_length, self.rig_compliance, kernel, self.log_datums)

@@ -52,12 +52,8 @@ def turning_loop(stroke: float, increments: int, tangential_increment: Callable,
     stroke's increments are a quadrature along the stroke, evenly spaced; the pressure changes little over the
     side's 2δ_t (a fraction of an element), so holding it there draws the side as it is, for tangential solves
     only.  ``tangential_increment(q, p, du)`` → (q, ds, stick, iterations); ``side_of(p)`` → 2δ_t (mm)."""
-    q_low = low[0]
-    us, qs = [-stroke], [float(q_low.sum()) * area]
-    for (q, p), sign in ((low, +1), (high, -1)):
-        if sign < 0:
-            us.append(stroke)
-            qs.append(float(q.sum()) * area)
+    us, qs = [-stroke], [float(low[0].sum()) * area]
+    for (q, p), sign in ((low, +1), (high, -1)):  # the down half starts from the cycle's own state at +δ
         for u0, u1 in half_stroke(stroke, side_of(p), sign, increments):
             q = tangential_increment(q, p, u1 - u0)[0]
             us.append(u1)

@@ -44,20 +44,21 @@ class Cycles:
 
 
 def tangential_operator(case: Case, grid: Grid):
-    """Both bodies' tangential compliance on the grid, the 2D datum and the rig's compliance
-    (:mod:`fretsim.compliance.tangential`)."""
+    """Both bodies' tangential compliance on the grid, the 2D datum (or each body's from its shape) and the rig's
+    compliance (:mod:`fretsim.compliance.tangential`)."""
     plane = grid.plane_strain
     volume_factor = case.geometry.line_length if plane else 1.0
     k_t = case.loading.tangential_stiffness
     rig = grid.area * volume_factor / k_t if k_t else 0.0
-    bodies = [(m.youngs_modulus, m.poissons_ratio) for m in (case.moving, case.stationary)]
-    return Tangential(grid, bodies, case.geometry.line_length if plane or any(datums(case)) else None, rig,
-                      datums=datums(case))
+    bodies_ = [(m.youngs_modulus, m.poissons_ratio) for m in (case.moving, case.stationary)]
+    logs = log_datums(case)
+    return Tangential(grid, bodies_, case.geometry.line_length if plane or any(x is not None for x in logs) else None,
+                      rig, log_datums=logs)
 
 
-def datums(case: Case) -> tuple:
-    """Each body's datum distance (mm) from its shape (geometry.flat_width/flat_thickness, moving_height), None
-    where it is a half-space: the loaded strip taken as the unworn contact at the peak load."""
+def _shapes(case: Case) -> tuple:
+    """Each body's shape (None: a half-space) and the loaded strip's half-width (mm): the unworn contact at the peak
+    load; shapes not much larger than that contact refused."""
     e_star = effective_modulus(case.moving.youngs_modulus, case.moving.poissons_ratio,
                                case.stationary.youngs_modulus, case.stationary.poissons_ratio)
     shapes, strip = case.geometry.tangential_shapes(case.geometry.hertz(case.loading.peak_load, e_star).half_width_x)
@@ -69,7 +70,22 @@ def datums(case: Case) -> tuple:
                 for key, value in case.geometry.shape_sizes() if value < SHAPE_TO_CONTACT * 2 * strip]
     if problems:
         raise CaseError(case.source, problems)
-    return tuple(None if shape is None else bodies.datum(shape, m.youngs_modulus, m.poissons_ratio, strip)
+    return shapes, strip
+
+
+def log_datums(case: Case) -> tuple:
+    """ln of each body's datum distance (mm) from its shape (geometry.flat_width/flat_thickness, moving_height),
+    None where it is a half-space."""
+    shapes, strip = _shapes(case)
+    return tuple(None if shape is None else bodies.log_datum(shape, m.youngs_modulus, m.poissons_ratio, strip)
+                 for shape, m in zip(shapes, (case.moving, case.stationary)))
+
+
+def strip_compliances(case: Case) -> tuple:
+    """Each body's mean strip displacement per unit tangential force per unit length (mm per N/mm) from its shape,
+    None where it is a half-space (what /inputs records)."""
+    shapes, strip = _shapes(case)
+    return tuple(None if shape is None else bodies.strip_compliance(shape, m.youngs_modulus, m.poissons_ratio, strip)
                  for shape, m in zip(shapes, (case.moving, case.stationary)))
 
 
@@ -172,8 +188,11 @@ def build(case: Case, plan: Plan, grids, model, regime_: Regime) -> Cycles:
     shapes = [key for key, _ in case.geometry.shape_sizes()]
     if shapes and not CYCLES[slip].needs_friction:
         plan.warnings.append(f"{', '.join(shapes)} given, but the {slip} cycle has every point slide with the rig: "
-                             f"the bodies' tangential compliance, which their shapes set, plays no part (give "
-                             f"loading.friction_coefficient and model.slip: {family.FRICTION})")
+                             f"the bodies' tangential compliance, which their shapes set, "
+                             + ("sets only δ_t (the regime), not the wear" if regime_.transition is not None else
+                                "plays no part (give loading.friction_coefficient")
+                             + f"; model.slip: {family.FRICTION} lets it take up the stroke"
+                             + ("" if regime_.transition is not None else ")"))
     if not members[0].linear:
         _check_incremental(case, grids, model, plan, regime_.transition)
     if STROKES[stroke_model]:
@@ -201,7 +220,8 @@ def _check_incremental(case: Case, grids, model, plan: Plan, transition: Optiona
                              f"problems uncoupled and neglects it")
     if model.corrections:
         plan.warnings.append(f"the corrections {', '.join(model.corrections)} add normal compliance only: the "
-                             f"tangential compliance is the half-spaces'")
+                             f"tangential compliance is the half-spaces'"
+                             + (" (or the bodies' shapes, where given)" if case.geometry.shape_sizes() else ""))
 
 
 def _warn_resolved(case: Case, plan: Plan) -> None:
