@@ -387,7 +387,7 @@ def _run(*overrides, case="mccoll_185N.yaml", output=None):
     return run(load_case(CASES / case, list(overrides)), output)
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # per worker, once: xdist interleaves modules, a module fixture is rebuilt
 def exact_per_cycle():
     """The exact model: one representative cycle per cycle (600 cycles, 2D)."""
     return _run(*COULOMB_2D, "loading.cycles=600", "output.snapshots=[0, 200, 600]", "jumping.scheme=linear",
@@ -415,7 +415,7 @@ PARTIAL_2D = ["model.dimension=2d", "loading.friction_coefficient=0.9", "loading
               "output.snapshots=[0, 1000, 3000]"]
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # per worker, once: xdist interleaves modules, a module fixture is rebuilt
 def exact_partial_slip():
     """The exact model in partial slip (McColl's cylinder at 0.4 µm, well below δ_t): a cycle per cycle."""
     return _run(*PARTIAL_2D, "jumping.scheme=linear", "jumping.linear=1")

@@ -174,7 +174,7 @@ def _rows(outdir):
         return {r["point"]: r for r in csv.DictReader(fh)}
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # per worker, once: xdist interleaves modules, a module fixture is rebuilt
 def sweep_reference(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("ref")
     (tmp / "s.yaml").write_text(SLOW_SWEEP)

@@ -253,7 +253,7 @@ def test_a_coarse_grid_of_a_nanometre_is_refused_by_the_memory_check_not_a_trace
 
 # --- hostile results files ------------------------------------------------------------------------------------------
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # per worker, once: xdist interleaves modules, a module fixture is rebuilt
 def good_file(tmp_path_factory):
     path = tmp_path_factory.mktemp("good") / "good.h5"
     run(load_case(CASE, ["model.dimension=2d", "loading.cycles=600"]), path)
@@ -263,7 +263,7 @@ def good_file(tmp_path_factory):
     return path
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # per worker, once: xdist interleaves modules, a module fixture is rebuilt
 def genuine_resume(good_file, tmp_path_factory):
     path = tmp_path_factory.mktemp("genuine") / "g.h5"
     path.write_bytes(good_file.read_bytes())

@@ -23,7 +23,7 @@ ROOT = Path(__file__).resolve().parent.parent
 CASE = ROOT / "cases" / "mccoll_185N.yaml"
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # per worker, once: xdist interleaves modules, a module fixture is rebuilt
 def results_3d(tmp_path_factory):
     path = tmp_path_factory.mktemp("r3") / "r3.h5"
     run(load_case(CASE, ["loading.cycles=1000", "output.snapshots=[0, 500, 1000]"]), path)

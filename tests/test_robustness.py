@@ -199,7 +199,7 @@ def _kill_at(tmp_path, sig, rows, name):
     return out, code
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # per worker, once: xdist interleaves modules, a module fixture is rebuilt
 def long_reference(tmp_path_factory):
     path = tmp_path_factory.mktemp("ref") / "ref.h5"
     sets = [LONG[i + 1] for i in range(0, len(LONG), 2)]

@@ -320,7 +320,7 @@ TRUTH = ["model.dimension=2d", "materials.moving.wear_coefficient=3e-8 1/MPa",
          "grid.error_estimate=none", "jumping.tolerance=1e-3"]
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # per worker, once: xdist interleaves modules, a module fixture is rebuilt
 def synthetic(tmp_path_factory):
     """Depths of both bodies at three cycles and the flat's final width, from a run with known coefficients,
     with 1 % noise (seeded)."""

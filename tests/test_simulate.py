@@ -28,7 +28,7 @@ STEPPING = 1e-3
 pytestmark = pytest.mark.xdist_group("test_simulate")
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # per worker, once: xdist interleaves modules, a module fixture is rebuilt
 def results_of(tmp_path_factory):
     """Runs a shipped case into this module's temporary directory once per process; its results as read back."""
     out_dir = tmp_path_factory.mktemp("simulate")
@@ -44,7 +44,7 @@ def results_of(tmp_path_factory):
     return results_of
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # per worker, once: xdist interleaves modules, a module fixture is rebuilt
 def summary_of(results_of):
     return lambda name, dimension, *overrides: results_of(name, dimension, *overrides).summary
 

@@ -88,7 +88,7 @@ points:
         {"jumping.eta": 0.1, "jumping.max": 100}, {"jumping.eta": 1.0, "jumping.max": 600}]
 
 
-@pytest.fixture(scope="module")
+@pytest.fixture(scope="session")  # per worker, once: xdist interleaves modules, a module fixture is rebuilt
 def local_sweep(tmp_path_factory):
     tmp = tmp_path_factory.mktemp("sweep")
     out = tmp / "local"
