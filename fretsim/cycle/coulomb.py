@@ -209,9 +209,8 @@ class CoulombCycle:
             s, q = s + ds, q_new
             p_prev, ds_prev, du_prev = p, ds, du
         if self.resolved and detail and not self.rigid:
-            tally.loop_u, tally.loop_q = turning_loop(self.stroke, max(LOOP_SIDE_INCREMENTS, self.increments),
-                                                      self._tangential, self._elastic_side, (q_low, p_low),
-                                                      (q_high, p_high), tally.area)
+            tally.loop_u, tally.loop_q = turning_loop(self.stroke, fine, self._tangential, self._elastic_side,
+                                                      (q_low, p_low), (q_high, p_high), tally.area)
         defect, mismatch = 0.0, None
         if step:
             defect, mismatch = self._defect(wear_moving, wear_stationary, step, w_lin, tally, p_mid, travel_mid,
@@ -349,10 +348,9 @@ def _nearest_in_contact(values: np.ndarray, on: np.ndarray) -> np.ndarray:
     idx = np.arange(nx)
     for r in np.flatnonzero(on.any(axis=1)):
         inside = np.flatnonzero(on[r])
-        nearest = inside[np.clip(np.searchsorted(inside, idx), 0, inside.size - 1)]
-        left = inside[np.clip(np.searchsorted(inside, idx) - 1, 0, inside.size - 1)]
-        nearest = np.where(np.abs(idx - left) <= np.abs(idx - nearest), left, nearest)
-        out[r] = values[r, nearest]
+        at = np.searchsorted(inside, idx)
+        right, left = inside[np.minimum(at, inside.size - 1)], inside[np.maximum(at - 1, 0)]
+        out[r] = values[r, np.where(idx - left <= right - idx, left, right)]
     return out
 
 

@@ -187,12 +187,11 @@ def build(case: Case, plan: Plan, grids, model, regime_: Regime) -> Cycles:
     members = tuple(built.setdefault(b, member(b)) for b in case.loading.blocks)
     shapes = [key for key, _ in case.geometry.shape_sizes()]
     if shapes and not CYCLES[slip].needs_friction:
+        effect = ("sets only δ_t (the regime), not the wear" if regime_.transition is not None else
+                  "plays no part (there is no loading.friction_coefficient)")
         plan.warnings.append(f"{', '.join(shapes)} given, but the {slip} cycle has every point slide with the rig: "
-                             f"the bodies' tangential compliance, which their shapes set, "
-                             + ("sets only δ_t (the regime), not the wear" if regime_.transition is not None else
-                                "plays no part (give loading.friction_coefficient")
-                             + f"; model.slip: {family.FRICTION} lets it take up the stroke"
-                             + ("" if regime_.transition is not None else ")"))
+                             f"the bodies' tangential compliance, which their shapes set, {effect}; model.slip: "
+                             f"{family.FRICTION} lets it take up the stroke")
     if not members[0].linear:
         _check_incremental(case, grids, model, plan, regime_.transition)
     if STROKES[stroke_model]:
