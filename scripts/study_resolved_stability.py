@@ -7,9 +7,11 @@ Cases longer than 5 000 cycles run their first 5 000 (a service case's 10⁹ wou
 explicit schemes take minutes for 20 000 on the Kirk cases); the table is rewritten after each case, so a
 stopped study keeps what it ran.  Report, do not tune.
 
-    python scripts/study_resolved_stability.py [--quick]
+    python scripts/study_resolved_stability.py [--quick] [--from CASE]
 
-Prints a table; writes scripts/out/resolved_stability.{txt,csv}.
+Prints a table; writes scripts/out/resolved_stability.{txt,csv} (``--from CASE``: the cases from CASE on,
+alphabetically, into scripts/out/resolved_stability_from_CASE.{txt,csv}, so that a study stopped part-way is
+continued without running again what it ran).
 """
 from __future__ import annotations
 
@@ -41,10 +43,11 @@ def overrides(path: Path) -> list[str]:
     return sets
 
 
-def main(quick: bool = False) -> None:
+def main(quick: bool = False, start: str = "") -> None:
     say = Report()
     rows = []
-    paths = sorted((ROOT / "cases").glob("*.yaml"))[: 3 if quick else None]
+    paths = [p for p in sorted((ROOT / "cases").glob("*.yaml")) if p.stem >= start][: 3 if quick else None]
+    name = f"resolved_stability_from_{start}" if start else "resolved_stability"
     say(f"{'case':<24}{'scheme':<10}{'status':<12}{'s':>7}  message")
     for path in paths:
         try:
@@ -71,16 +74,17 @@ def main(quick: bool = False) -> None:
                          "message": " ".join(message.split())})
             say(f"{path.stem:<24}{scheme:<10}{status:<12}{seconds:>7.1f}  {first}")
         OUT.mkdir(parents=True, exist_ok=True)
-        say.write(OUT / "resolved_stability.txt")
+        say.write(OUT / f"{name}.txt")
     counts = {}
     for r in rows:
         counts[r["status"]] = counts.get(r["status"], 0) + 1
     say("")
     say("runs by status: " + ", ".join(f"{k} {v}" for k, v in sorted(counts.items())))
     OUT.mkdir(parents=True, exist_ok=True)
-    write_csv(rows, OUT / "resolved_stability.csv")
-    say.write(OUT / "resolved_stability.txt")
+    write_csv(rows, OUT / f"{name}.csv")
+    say.write(OUT / f"{name}.txt")
 
 
 if __name__ == "__main__":
-    main("--quick" in sys.argv)
+    args = sys.argv[1:]
+    main("--quick" in args, args[args.index("--from") + 1] if "--from" in args else "")
