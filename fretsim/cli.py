@@ -679,9 +679,11 @@ def init(kind: str, output: Path | None) -> None:
               show_default=True, help="Directory for report.md and its figures.")
 @click.option("--jobs", type=click.IntRange(0, 256), default=0, help="Parallel runs; 0 (the default): the number of cores.")
 @click.option("--quick", is_flag=True, help="Line contacts in 2D and point contacts short: the check in a minute.")
+@click.option("--friction", is_flag=True, help="Add McColl's cases under the FE model's friction (μ 0.9) and bodies, "
+              "uniform, mid-stroke and resolved (2D and 3D: several minutes more).")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
 @_boundary
-def validate(cases: tuple, outdir: Path, jobs: int, quick: bool, debug: bool) -> None:
+def validate(cases: tuple, outdir: Path, jobs: int, quick: bool, friction: bool, debug: bool) -> None:
     """Run the published cases of the paper (default: every shipped case with expected values) and write a
     report against experiment, FEA and the paper.  Exit 0 when every case runs."""
     from fretsim.validate import shipped_with_expected, validate as run_validation
@@ -691,7 +693,7 @@ def validate(cases: tuple, outdir: Path, jobs: int, quick: bool, debug: bool) ->
     if unknown:
         raise Fail(f"no shipped case with expected values named {', '.join(unknown)}; choose from "
                    f"{', '.join(shipped_with_expected())}")
-    out = run_validation(names, outdir, jobs, quick)
+    out = run_validation(names, outdir, jobs, quick, friction=friction)
     click.echo(f"{len(out['results'])} runs; report: {out['report']}")
     if not out["ok"]:
         raise Fail("some cases did not complete: see the report", EXIT_FAILED)

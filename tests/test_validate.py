@@ -54,6 +54,34 @@ def test_quick_validation_reports_against_experiment_fea_and_paper_reading_each_
     assert max(profile) == pytest.approx(out["results"]["mccoll_185N"]["summary"]["centre_wear_depth_stationary_um"])
 
 
+def test_friction_validation_runs_each_cycle_model_with_the_fe_bodies_against_the_files_fea(tmp_path, monkeypatch):
+    # the FEA value changed in a copy: the section and its MAPE must be computed from the file's number
+    cases = tmp_path / "cases"
+    shutil.copytree(CASES, cases)
+    p = cases / "mccoll_500N_10um.yaml"
+    text = p.read_text()
+    assert "fea: {centre_wear_depth_stationary: 4.0 um" in text
+    p.write_text(text.replace("fea: {centre_wear_depth_stationary: 4.0 um", "fea: {centre_wear_depth_stationary: 4.4 um"))
+    monkeypatch.setattr(validate_module, "CASES", cases)
+    out = validate_module.validate(["mccoll_500N_10um", "table1_case1"], tmp_path / "v", jobs=1, quick=True,
+                                   friction=True)
+    assert out["ok"]
+    friction = {k: r for k, r in out["results"].items() if k.startswith("friction:")}
+    # one run per model of the cycle, in 2D (quick), the ball (no FEA, no block) left out
+    assert sorted(friction) == sorted(f"friction:mccoll_500N_10um:2d:{m}" for m in validate_module.FRICTION_MODELS)
+    for r in friction.values():
+        assert set(validate_module.FE_MODEL) <= set(r["overrides"])
+    report = out["report"].read_text()
+    assert "## Table 4 with the FE model's friction and bodies" in report
+    depth = {m: friction[f"friction:mccoll_500N_10um:2d:{m}"]["summary"]["centre_wear_depth_stationary_um"]
+             for m in validate_module.FRICTION_MODELS}
+    # the models differ (friction and the resolved stroke move the depth), so the rows cannot be one run repeated
+    assert len({round(d, 4) for d in depth.values()}) == 3
+    for m, d in depth.items():
+        row = next(line for line in report.splitlines() if line.startswith(f"| 2D | {m} |"))
+        assert row.split("|")[3].strip() == f"{100 * abs(d - 4.4) / 4.4:.1f} %"  # depth vs the file's FEA
+
+
 def test_validate_refuses_an_unknown_case_name():
     r = CliRunner().invoke(main, ["validate", "no_such_case"])
     assert r.exit_code == 2 and "no shipped case" in r.output
