@@ -16,7 +16,7 @@ import numpy as np
 
 from fretsim import grid_error
 from fretsim.case import GEOMETRY_KEYS, Case, CaseError, parse_case
-from fretsim.plan import Plan, SideRuns, estimate_cost, prepare
+from fretsim.plan import Plan, SideRuns, estimate_cost, prepare, restore
 from fretsim.plan.cycle import strip_compliances
 from fretsim.reference import effective_modulus
 from fretsim.results import (OutputBusy, OutputClaim, Results, ResultsIOError, ResultsWriter, check_output_path,
@@ -184,6 +184,8 @@ def resume(output: str | Path, *, progress: Optional[Callable[[int], None]] = No
                                                f"killed run ({' or '.join(RESUMABLE)}) can be resumed")])
         case = parse_case(previous.case_yaml, source=f"{output}:/case")
         setup, filled, plan = prepare(case, runs=runs)
+        # the first part's reasons and notes, not "given in the case" for every automatic choice
+        setup, plan = restore(setup, plan, previous.provenance, str(previous.attrs.get("notes", "")))
         n = previous.checkpoint.get("n")
         if not isinstance(n, int) or not 0 <= n <= setup.cycles:
             raise CaseError(str(output), [("", f"/checkpoint: the cycle {str(n)[:20]} does not fit the case's "

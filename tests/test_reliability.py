@@ -164,6 +164,36 @@ def test_a_run_killed_as_it_finished_resumes_to_complete_at_once(tmp_path):
         assert resume(out0).status == "complete"
 
 
+class _CtrlC:
+    """An observer that interrupts the run at its n-th accepted step, as Ctrl-C would."""
+
+    def __init__(self, n: int):
+        self.n = n
+
+    def on_step(self, setup, step):
+        self.n -= 1
+        if self.n == 0:
+            raise KeyboardInterrupt
+
+
+def test_a_resumed_run_keeps_every_automatic_choice_its_reason_and_auto_s_error(tmp_path):
+    """A resume plans again from the filled case, in which every automatic choice is written out: /choices used to
+    read "given in the case" for all of them, and the model difference auto accepted (uniform slip at δ_t/δ =
+    2.7 % here) dropped out of the resumed run's error estimates."""
+    sets = ["model.dimension=2d", "loading.friction_coefficient=0.9", "model.accuracy=0.05", "loading.cycles=3000"]
+    whole = run(load_case(CASE, sets), tmp_path / "whole.h5")
+    assert any(c.key == "model.slip" and not c.given and c.error > 0.02 for c in whole.plan.choices)
+    with pytest.raises(KeyboardInterrupt):
+        run(load_case(CASE, sets), tmp_path / "cut.h5", observers=(_CtrlC(12),))
+    assert read_results(tmp_path / "cut.h5").status == "interrupted"
+    assert resume(tmp_path / "cut.h5").status == "complete"
+    a, b = read_results(tmp_path / "whole.h5"), read_results(tmp_path / "cut.h5")
+    assert b.choices == a.choices and b.provenance == a.provenance
+    assert b.attrs["notes"] == a.attrs["notes"]
+    for key in ("estimated_error_depth", "estimated_error_width", "centre_wear_depth_stationary_um"):
+        assert b.summary[key] == a.summary[key], key
+
+
 def test_two_ctrl_c_in_quick_succession_leave_a_consistent_interrupted_file(tmp_path):
     for k in range(3):
         out = tmp_path / f"i{k}.h5"

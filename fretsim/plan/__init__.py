@@ -18,6 +18,7 @@ choices the case made itself are listed too, as "given".
 """
 from __future__ import annotations
 
+import dataclasses
 import functools
 from typing import Optional
 
@@ -32,7 +33,7 @@ from fretsim.stepping.implicit import DEPTH_SHARE
 from fretsim.wear import wear_reach
 
 __all__ = ["Choice", "Plan", "SideRuns", "available_corrections", "estimate_cost", "estimate_solves", "prepare",
-           "show"]
+           "restore", "show"]
 
 
 def prepare(case: Case, allow_unstable: bool = False, runs: Optional[SideRuns] = None, *,
@@ -87,8 +88,32 @@ def _setup(case: Case, plan: Plan, grids, operators, regime, cycles, steps) -> S
                  implicit_cap=steps.implicit_cap, coarse=grids.coarse, coarse_compliance=operators.coarse_compliance,
                  coarse_gap=operators.coarse_gap, per_cycle=steps.per_cycle,
                  gross_slip_stroke=regime.transition if regime.transition is not None else float("nan"),
-                 notes=tuple(f"{c.key} = {show(c.value)}: {c.reason}" for c in plan.choices if not c.given)
-                 + tuple(plan.warnings))
+                 notes=_notes(plan))
+
+
+def _notes(plan: Plan) -> tuple:
+    """The results file's notes: each automatic choice with its reason, then the plan's warnings."""
+    return tuple(f"{c.key} = {show(c.value)}: {c.reason}" for c in plan.choices if not c.given) + tuple(plan.warnings)
+
+
+def restore(setup: Setup, plan: Plan, provenance: list, notes: str = "") -> tuple[Setup, Plan]:
+    """A resumed run's plan with the provenance its first part recorded (``Results.provenance``: key, value text,
+    reason, given, error).  Planned again from the filled case, every choice reads "given in the case" and auto's
+    accepted model differences (part of the error estimates) are gone; the values are the same (a given one as the
+    case gave it: the filled case trims, e.g., recorded states past the last cycle), the reasons the first plan's,
+    and so are the results file's ``notes`` where given (the first plan's warnings too: the skipped recorded
+    states' is not raised again by the trimmed case)."""
+    recorded = {key: (value, reason, given, error) for key, value, reason, given, error in provenance
+                if given is not None}
+    choices = []
+    for c in plan.choices:
+        if c.key in recorded:
+            value, reason, given, error = recorded[c.key]
+            c = dataclasses.replace(c, value=value if given else c.value, reason=reason, given=bool(given),
+                                    error=float(error))
+        choices.append(c)
+    plan = dataclasses.replace(plan, choices=choices)
+    return dataclasses.replace(setup, notes=tuple(notes.split("\n")) if notes else _notes(plan)), plan
 
 
 def _filled(case: Case, grids, operators, cycles, steps) -> Case:

@@ -4,7 +4,8 @@
                        input_sha256 (the case as asked for, before the plan filled it: Case.fingerprint)
     /case              the validated case with defaults and automatic choices filled (YAML text; attr sha256)
     /inputs            the resolved inputs as scalar datasets with units; attrs overrides (the --set items), case_file
-    /choices           every automatic choice: key, value, reason, given (one entry each)
+    /choices           every automatic choice: key, value, reason, given, error (the model difference auto
+                       accepted with it, a share; since 1.4 files of fretsim after issue 31: absent → 0)
     /grid/x, /grid/y   element centres (mm)
     /history/<name>    one entry per accepted step over the dimension ``step``, ``cycle`` its coordinate
     /fields/<name>     at the snapshot cycles: (cycle, y, x), with ``cycle``, ``y``, ``x`` as dimension scales

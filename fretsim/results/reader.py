@@ -36,6 +36,7 @@ class Results:
     checkpoint: Optional[dict] = None
     fretting_loop: dict = field(default_factory=dict)  # cycle, displacement (um), tangential_force (N)
     choices: list = field(default_factory=list)  # (key, value, reason) of every automatic choice
+    provenance: list = field(default_factory=list)  # (key, value, reason, given, error) of each, as first planned
     inputs: dict = field(default_factory=dict)  # name: (value, units)
     overrides: list = field(default_factory=list)
 
@@ -187,14 +188,21 @@ def _read(f, path: str, for_resume: bool) -> Results:
                        f"that wrote it ({attrs.get('fretsim_version', '?')})")
     if for_resume and checkpoint is None:
         raise _Damaged("/checkpoint: missing; the run cannot be resumed (it was written before its first step)")
-    choices = []
+    choices, provenance = [], []
     if "choices" in f:
         _group(f, "choices")
         cols = [[text(v) for v in _dataset(f, f"choices/{k}", 1, numeric=False)] for k in ("key", "value", "reason")]
         choices = list(zip(*cols))
+        n = len(choices)
+        given = (_dataset(f, "choices/given", 1).astype(bool).tolist() if "given" in f["choices"] else [None] * n)
+        error = (_dataset(f, "choices/error", 1).astype(float).tolist() if "error" in f["choices"] else [0.0] * n)
+        if len(given) != n or len(error) != n:
+            raise _Damaged(f"/choices: {n} keys but {len(given)} given flags and {len(error)} errors")
+        provenance = [(*c, g, e) for c, g, e in zip(choices, given, error)]
     inputs, overrides = _read_inputs(f)
     return Results(path=path, attrs=attrs, case_yaml=case_yaml, x=x, y=y, history=history, fields=fields,
                    summary=summary, units=units, checkpoint=checkpoint, fretting_loop=loop, choices=choices,
+                   provenance=provenance,
                    inputs=inputs, overrides=overrides)
 
 

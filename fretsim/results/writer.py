@@ -157,6 +157,9 @@ class ResultsWriter:
         w.dataset(ch, "value", [_valuetext(c.value) for c in self.choices], text)
         w.dataset(ch, "reason", [c.reason for c in self.choices], text)
         w.dataset(ch, "given", np.array([c.given for c in self.choices], dtype=np.int8))
+        # the model difference auto accepted with each choice (part of the reported error estimates): a resumed
+        # run, which plans again from the filled case where every choice reads as given, takes it from here
+        w.dataset(ch, "error", np.array([c.error for c in self.choices], dtype=np.float64))
         g = w.group(f, "grid")
         for name, values in (("x", grid.x), ("y", grid.y)):
             w.dataset(g, name, values, units="mm",
