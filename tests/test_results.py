@@ -253,14 +253,48 @@ def test_dimension_is_accepted_in_capitals():
 def test_a_format_1_1_file_is_still_read(results_3d, tmp_path):
     old = tmp_path / "v11.h5"
     old.write_bytes(results_3d.read_bytes())
-    with h5py.File(old, "r+") as f:  # what the 1.1 writer made: none of 1.2's additions
+    with h5py.File(old, "r+") as f:  # what the 1.1 writer made: none of 1.2's, 1.3's or 1.4's additions
         for path in ("inputs", "choices", "history/error_estimate_depth", "history/error_estimate_pressure",
-                     "fields/x", "fields/y"):
-            del f[path]
-        del f["case"].attrs["sha256"]
+                     "fields/x", "fields/y", "history/block", "history/dissipated_energy_J", "history/wear_work",
+                     "fields/slip_distance_moving", "fields/slip_distance_stationary", "fields/shear_traction",
+                     "fretting_loop"):
+            if path in f:
+                del f[path]
         f.attrs["format_version"] = "1.1"
+        for obj in [f] + [f[name] for name in _names(f)]:  # no checksums at all
+            for key in ("sha256", "attrs_sha256"):
+                if key in obj.attrs:
+                    del obj.attrs[key]
     res = read_results(old)
     assert res.summary["cycles"] == 1000 and res.inputs == {}
+
+
+def _names(f) -> list:
+    names = []
+    f.visit(names.append)
+    return names
+
+
+@pytest.mark.parametrize("version", ["1.1", "1.2"])
+def test_a_version_older_than_the_file_never_switches_its_checksums_off(results_3d, tmp_path, version):
+    """With format_version set back to 1.1 (or 1.2, before every object was sealed), an edited history value used
+    to be read, summarised, plotted and exported without a word: a version older than what the file holds is
+    damage, and a file with checksums is verified whatever its version says."""
+    path = tmp_path / "down.h5"
+    path.write_bytes(results_3d.read_bytes())
+    with h5py.File(path, "r+") as f:
+        f.attrs["format_version"] = version
+        d = f["history/max_pressure"]
+        d[1] = d[1] * 1.5
+    for command in (["summary", str(path)], ["plot", str(path), "-o", str(tmp_path / "p.png")],
+                    ["export", str(path), "--csv", str(tmp_path / "csv")]):
+        r = CliRunner().invoke(main, command)
+        assert r.exit_code == 2 and "older than what the file holds" in r.output, (command, r.output)
+    assert not (tmp_path / "p.png").exists() and not (tmp_path / "csv").exists()
+    with h5py.File(path, "r+") as f:  # the 1.4 and 1.3 additions gone too: the checksums still hold it
+        del f["history/block"], f["fretting_loop"]
+    r = CliRunner().invoke(main, ["summary", str(path)])
+    assert r.exit_code == 2 and "checksum" in r.output, r.output
 
 
 MODULES = ROOT / "fretsim"

@@ -206,6 +206,30 @@ def _read(f, path: str, for_resume: bool) -> Results:
                    inputs=inputs, overrides=overrides)
 
 
+# what each format added that a file of an older one cannot hold: (test, its description)
+_FORMAT_MARKS = {
+    "1.4": (lambda f: isinstance(f.get("history"), h5py.Group) and "block" in f["history"], "/history/block"),
+    "1.3": (lambda f: "fretting_loop" in f or _any_checksum(f), "/fretting_loop or the checksums of every object"),
+    "1.2": (lambda f: "choices" in f or "inputs" in f, "/choices or /inputs"),
+}
+
+
+def _any_checksum(f) -> bool:
+    """Whether any object of the file carries the seal of format 1.3 on (1.2 had checksums on /case and
+    /checkpoint only)."""
+    if "attrs_sha256" in f.attrs:
+        return True
+    found = []
+    f.visititems(lambda name, obj: found.append(name) if "attrs_sha256" in obj.attrs or (
+        "sha256" in obj.attrs and name.split("/")[0] not in ("case", "checkpoint")) else None)
+    return bool(found)
+
+
+def _format_held(f) -> str:
+    """The newest format whose additions the file holds ("1.1" for none)."""
+    return next((v for v, (holds, _) in _FORMAT_MARKS.items() if holds(f)), "1.1")
+
+
 def _read_head(f, path: str) -> tuple[str, dict, str]:
     """The format version (its checksums verified), the root's attributes and the case's text."""
     if "format_version" not in f.attrs:
@@ -213,7 +237,11 @@ def _read_head(f, path: str) -> tuple[str, dict, str]:
     version = text(f.attrs["format_version"])
     if version not in READABLE_FORMATS:
         raise _Damaged(f"format_version {version!r} is not one this fretsim reads ({', '.join(READABLE_FORMATS)})")
-    if version >= SEALED_FROM:
+    held = _format_held(f)
+    if held > version:
+        raise _Damaged(f"format_version {version!r} is older than what the file holds (format {held}: "
+                       f"{_FORMAT_MARKS[held][1]}): its version was changed since it was written")
+    if version >= SEALED_FROM or held >= SEALED_FROM:  # never a version that lets the checksums go unread
         _verify_seal(f)
     attrs = {k: plain(v) for k, v in f.attrs.items() if k not in _SCALE_ATTRS}
     if attrs.get("status") not in STATUSES:
