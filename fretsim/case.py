@@ -987,9 +987,15 @@ def _check_model(r: "_Reader", geometry, materials: dict, model: dict, mu: Optio
     if model.get("increments") is not None and model["increments"] % 2 == 0:
         r.fail("model.increments", f"{model['increments']} is even; expected an odd number, so that one increment "
                                    f"is centred on mid-stroke (e.g. {model['increments'] + 1})")
+    # μ = 0 is frictionless: no shear traction, every point slides the whole stroke (the uniform model, exact)
     if mu == 0 and slip in CYCLES and CYCLES[slip].needs_friction:
-        r.fail("loading.friction_coefficient", f"0 with model.slip {slip}: without friction nothing resists "
-                                               f"the stroke and nothing wears by it; give μ > 0")
+        r.fail("loading.friction_coefficient", f"0 with model.slip {slip}: without friction there is no shear "
+                                               f"traction to resolve and every point slides the whole stroke, which "
+                                               f"model.slip uniform (or auto) models exactly; give μ > 0 for "
+                                               f"Coulomb friction")
+    elif mu == 0 and why:
+        r.fail("loading.friction_coefficient", f"0 with {why}: without friction it has nothing to work with "
+                                               f"(no shear traction, no dissipated energy); give μ > 0")
 
 
 def _loading(r: "_Reader", load: dict, blocks: Optional[tuple], repeat: int, spectrum: bool) -> Loading:
@@ -997,6 +1003,11 @@ def _loading(r: "_Reader", load: dict, blocks: Optional[tuple], repeat: int, spe
     mu, k_t, frequency = load.get("friction_coefficient"), load.get("tangential_stiffness"), load.get("frequency")
     if blocks is None:
         return Loading.constant(load["normal_load"], load["stroke"], load["cycles"], mu, k_t, frequency)
+    if load.get("cycles") == 0:  # a history cut to no cycles applies none of its blocks: no load to solve for
+        r.fail("loading.cycles", f"0 with loading.{'spectrum' if spectrum else 'blocks'}: no block would be applied; "
+                                 f"give the cycles the history runs for" + ("" if spectrum else
+                                                                           " (or leave it out: the blocks' own)")
+               + ", or a single normal_load and stroke for the unworn contact alone")
     applied = expand(blocks, repeat, load.get("cycles"), spectrum)
     if len(applied) > MAX_BLOCKS:
         r.fail("loading.repeat", f"{len(applied)} blocks in all; at most {MAX_BLOCKS} (each restarts the "

@@ -11,6 +11,7 @@ the traceback only under ``--debug``.
 from __future__ import annotations
 
 import functools
+import math
 import os
 import sys
 import traceback
@@ -270,14 +271,31 @@ class _Progress:
             self.bar = None
 
 
+def _check_regime(setup, loading) -> str:
+    """`check`'s regime line: the stroke of the block δ_t was judged on (the one nearest partial slip) against it."""
+    d_t, block, mu = setup.gross_slip_stroke, setup.regime_block, loading.friction_coefficient
+    stroke, mu = (block.stroke, block.friction_coefficient) if block is not None else (loading.peak_stroke, mu)
+    which = " of the block nearest partial slip" if len({(b.stroke, b.normal_load) for b in loading.given}) > 1 else ""
+    if d_t == 0.0:
+        return f"regime: gross slip — frictionless (μ = 0{which}): nothing sticks, every point slides the whole stroke"
+    regime = "gross slip" if stroke > d_t else "partial slip"
+    return (f"regime: {regime} at the start — the stroke{which} {stroke * 1e3:.4g} µm is {stroke / d_t:.3g}× the "
+            f"gross-slip limit δ_t = {d_t * 1e3:.4g} µm (μ = {mu:g}, the unworn contact)")
+
+
 def _regime(s: dict, c) -> str:
     """The regime sentence of the summary: measured (coulomb) or assumed (uniform slip)."""
     from fretsim.cycle import CYCLES
     if CYCLES[c.slip].assumes_gross_slip:
-        known = "" if c.loading.friction_coefficient is None else (
-            f" (the stroke is {c.loading.peak_stroke / (s['gross_slip_stroke_um'] * 1e-3):.3g}× the gross-slip limit "
-            f"{s['gross_slip_stroke_um']:.3g} µm)")
-        return f"Gross slip assumed{known}."
+        d_t, strokes = s.get("gross_slip_stroke_um"), {b.stroke for b in c.loading.given}
+        if c.loading.friction_coefficient is None or d_t is None or not math.isfinite(d_t):
+            return "Gross slip assumed."
+        if d_t == 0.0:
+            return "Gross slip: frictionless (μ = 0), every point slides the whole stroke."
+        if len(strokes) > 1:  # δ_t is the block's nearest partial slip: no one stroke to set it against
+            return f"Gross slip assumed (the gross-slip limit {d_t:.3g} µm on the block nearest partial slip)."
+        return (f"Gross slip assumed (the stroke is {strokes.pop() / (d_t * 1e-3):.3g}× the gross-slip limit "
+                f"{d_t:.3g} µm).")
     where = (f"stick zone ±{s['stick_half_width_x_mm'] * 1e3:.3g} µm along x" if s["regime"] == "partial_slip"
              else "the whole contact slides")
     return (f"{s['regime'].replace('_', ' ').capitalize()} ({where}): tangential force amplitude "
@@ -379,11 +397,7 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
                + f", E* = {e_star / 1e3:.4g} GPa")
     click.echo(f"explicit stability limit: {setup.stability_limit:.4g} cycles (solve grid, gap model {filled.gap_model})")
     if loading.friction_coefficient is not None:
-        d_t, stroke = setup.gross_slip_stroke, loading.peak_stroke
-        regime = "gross slip" if stroke > d_t else "partial slip"
-        click.echo(f"regime: {regime} at the start — the stroke {stroke * 1e3:.4g} µm is "
-                   f"{stroke / d_t:.3g}× the gross-slip limit δ_t = {d_t * 1e3:.4g} µm (μ = "
-                   f"{loading.friction_coefficient:g}, the unworn contact)")
+        click.echo(_check_regime(setup, loading))
     from fretsim.runner import estimate
     cost = estimate(setup, filled, runs)
     total = cost["run_s"] + cost["companions_s"] + (planning if planning > 1.0 else 0.0)

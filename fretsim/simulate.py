@@ -68,6 +68,7 @@ class Setup:
     watch_growth: bool = True  # stop when an odd-even pressure pattern grows (off only to study instability)
     per_cycle: bool = True  # implicit schemes follow the per-cycle update (φ = h + ½r), not the continuous ODE
     gross_slip_stroke: float = float("nan")  # mm: δ_t of the unworn contact (NaN without a friction coefficient)
+    regime_block: Optional[object] = None  # the block δ_t is of (the one nearest partial slip)
     notes: tuple[str, ...] = ()
     block_cycles: tuple = ()  # a load history: the cycle model of each block of ``loading`` (empty: ``cycle``)
     wear_limits: dict = field(default_factory=dict)  # fretsim.limits: key -> limit (internal units)

@@ -563,3 +563,30 @@ def test_the_shipped_partial_slip_ball_meets_its_per_cycle_run(tmp_path):
         p_f, p_g = f["fields/pressure"][-1], g["fields/pressure"][-1]
     assert abs(d_f.max() / d_g.max() - 1) < 5e-3
     assert np.linalg.norm(p_f - p_g) / np.linalg.norm(p_g) < 2e-2
+
+
+def test_a_zero_friction_coefficient_is_frictionless_uniform_slip_with_no_energy(tmp_path):
+    """μ = 0 (allowed by the case reference) used to divide by δ_t = 0 in `check` and, after a complete run, in the
+    run's paragraph (exit 1).  Frictionless: no shear traction, nothing sticks, every point slides the whole stroke,
+    so auto picks the uniform model (exact here), the regime is gross slip, no energy is dissipated; Coulomb
+    friction and the energy law have nothing to work with and are refused in one paragraph."""
+    from click.testing import CliRunner
+    from fretsim.cli import main
+    from fretsim.results import read_results
+    from pathlib import Path
+    case = str(Path(__file__).resolve().parent.parent / "cases" / "mccoll_185N.yaml")
+    base = ["--set", "loading.friction_coefficient=0", "--set", "model.dimension=2d", "--set", "loading.cycles=1000",
+            "--set", "grid.error_estimate=none"]
+    r = CliRunner().invoke(main, ["check", case, *base])
+    assert r.exit_code == 0 and "frictionless (μ = 0)" in r.output, r.output
+    for extra in ([], ["--set", "model.slip=uniform"]):
+        out = tmp_path / f"r{len(extra)}.h5"
+        r = CliRunner().invoke(main, ["run", case, *base, *extra, "-o", str(out)])
+        assert r.exit_code == 0 and "frictionless (μ = 0)" in r.output, r.output
+        s = read_results(out).summary
+        assert s["regime"] == "gross_slip" and s["gross_slip_stroke_um"] == 0.0
+        assert s["dissipated_energy_per_cycle_J"] == 0.0 and s["tangential_force_amplitude_N"] == 0.0
+    for extra in (["--set", "model.slip=coulomb"], ["--set", "model.stroke=resolved"]):
+        r = CliRunner().invoke(main, ["run", case, *base, *extra, "-o", str(tmp_path / "x.h5")])
+        assert r.exit_code == 2 and "loading.friction_coefficient: 0 with" in r.output, r.output
+        assert not (tmp_path / "x.h5").exists()

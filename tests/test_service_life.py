@@ -424,3 +424,35 @@ def test_blocks_with_their_own_friction_coefficients_run_coulomb_and_keep_the_in
     for block, energy in zip(h["block"], h["dissipated_energy_J"]):
         full = (0.9, 0.3)[block] * 185 * 4 * 0.025  # N·mm: every point sliding the rig's whole travel
         assert 1 - take_up <= energy * 1e3 / full <= 1, (block, energy)
+
+
+def test_a_history_cut_to_no_cycles_is_refused_in_one_paragraph_naming_loading_cycles(tmp_path):
+    """`loading.cycles: 0` with blocks or a spectrum used to end in "min() arg is an empty sequence"."""
+    from click.testing import CliRunner
+    from fretsim.cli import main
+    spectrum = ("loading:\n  cycles: 0\n  spectrum:\n    - {normal_load: 185 N, stroke: 25 um, fraction: 0.5}\n"
+                "    - {normal_load: 100 N, stroke: 25 um, fraction: 0.5}\n")
+    for loading in (MIXED.replace("loading:\n", "loading:\n  cycles: 0\n"), spectrum):
+        path = tmp_path / "c.yaml"
+        path.write_text(BASE.format(name="c") + loading)
+        for command in (["check", str(path)], ["run", str(path), "-o", str(tmp_path / "r.h5")]):
+            r = CliRunner().invoke(main, command)
+            assert r.exit_code == 2 and "loading.cycles" in r.output and "Traceback" not in r.output, r.output
+            assert r.output.count("\n") <= 2 and not (tmp_path / "r.h5").exists()
+
+
+def test_check_sets_the_stroke_of_the_block_nearest_partial_slip_against_its_own_gross_slip_limit(tmp_path):
+    """A spectrum's δ_t is the block's nearest partial slip (5 µm at 300 N here); `check` used to set the largest
+    stroke of another block (50 µm) against it, and called the history 10× further from partial slip than it is."""
+    from click.testing import CliRunner
+    from fretsim.cli import main
+    path = tmp_path / "s.yaml"
+    path.write_text(BASE.format(name="s") + "loading:\n  cycles: 2000\n  friction_coefficient: 0.9\n  spectrum:\n"
+                    "    - {normal_load: 185 N, stroke: 50 um, fraction: 0.5}\n"
+                    "    - {normal_load: 300 N, stroke: 5 um, fraction: 0.5}\n")
+    r = CliRunner().invoke(main, ["check", str(path)])
+    assert r.exit_code == 0, r.output
+    line = next(s for s in r.output.splitlines() if s.startswith("regime:"))
+    d_t = float(line.split("δ_t = ")[1].split(" µm")[0])
+    ratio = float(line.split(" µm is ")[1].split("×")[0])
+    assert "block nearest partial slip 5 µm" in line and ratio == pytest.approx(5.0 / d_t, rel=2e-3), line

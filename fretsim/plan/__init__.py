@@ -88,6 +88,7 @@ def _setup(case: Case, plan: Plan, grids, operators, regime, cycles, steps) -> S
                  implicit_cap=steps.implicit_cap, coarse=grids.coarse, coarse_compliance=operators.coarse_compliance,
                  coarse_gap=operators.coarse_gap, per_cycle=steps.per_cycle,
                  gross_slip_stroke=regime.transition if regime.transition is not None else float("nan"),
+                 regime_block=regime.block if regime.transition is not None else None,
                  notes=_notes(plan))
 
 

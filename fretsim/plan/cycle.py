@@ -144,6 +144,10 @@ def choose_slip(case: Case, block: Block, transition: Optional[float]) -> Choice
     if mu is None:
         return Choice("model.slip", family.PAPER, "no friction coefficient: the paper's gross slip is assumed (give "
                                                   "loading.friction_coefficient to judge the regime)")
+    if transition == 0.0:  # μ = 0
+        return Choice("model.slip", family.PAPER, "frictionless (μ = 0): no shear traction, so nothing sticks and the "
+                                                  "bodies take none of the stroke elastically; every point slides the "
+                                                  "whole stroke, as the paper's uniform slip assumes (exact here)")
     deficit = transition / stroke
     if deficit > case.accuracy:
         return Choice("model.slip", family.FRICTION, f"gross slip (the stroke is {1 / deficit:.1f}× the limit δ_t = "
