@@ -146,7 +146,7 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
         previous_handler = signal.signal(signal.SIGTERM, _terminate)
     except ValueError:  # not the main thread (the CLI called from a thread): SIGTERM keeps its handler
         previous_handler = None
-    outcome = None
+    outcome, before = None, _file_id(output)
     try:
         if resume_file is not None:
             outcome = resume_run(resume_file, progress=progress.update, runs=runs)
@@ -155,11 +155,8 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
             outcome = run_case(case, output, overwrite=overwrite, progress=progress.update, on_plan=_on_plan,
                                runs=runs)
     except KeyboardInterrupt:
-        if _status_of(output) == "complete":  # the interrupt came after the last write
-            click.echo(f"interrupted after the run had completed: {output} holds the whole run (status 'complete')")
-            return
-        raise Fail(f"interrupted; every accepted step so far is in {output} (status 'interrupted'); continue with "
-                   f"`fretsim run --resume {output}`", EXIT_INTERRUPTED) from None
+        _interrupted(output, before, resume_file is not None)
+        return
     except OSError as exc:  # before any step: the output's place cannot be written
         raise Fail(f"cannot write {output}: {exc.strerror or exc}") from None
     finally:
@@ -211,6 +208,31 @@ def _side_runs(before=lambda: None) -> tuple:
             bar.stop()
 
     return SideRuns(announce, side_progress), said
+
+
+def _file_id(path) -> Optional[tuple]:
+    """What tells one version of a file from another (None: no file)."""
+    try:
+        st = os.stat(path)
+    except OSError:
+        return None
+    return st.st_ino, st.st_mtime_ns, st.st_size
+
+
+def _interrupted(output, before: Optional[tuple], resuming: bool) -> None:
+    """What an interrupted `run` says, true to what is on disk: the run complete after all, nothing of it written
+    (interrupted while planning, e.g. in auto's proxy runs: an earlier file of that name is as it was), or its
+    accepted steps kept for --resume."""
+    written = _file_id(output) != before
+    if written and _status_of(output) == "complete":  # the interrupt came after the last write
+        click.echo(f"interrupted after the run had completed: {output} holds the whole run (status 'complete')")
+        return
+    if not written and not resuming:
+        kept = f"; {output} is as it was before this run" if before is not None else ""
+        raise Fail(f"interrupted before the run's first step was written (while planning or in its first solve): "
+                   f"nothing was written{kept}; run the case again", EXIT_INTERRUPTED) from None
+    raise Fail(f"interrupted; every accepted step so far is in {output} (status 'interrupted'); continue with "
+               f"`fretsim run --resume {output}`", EXIT_INTERRUPTED) from None
 
 
 def _status_of(path) -> Optional[str]:

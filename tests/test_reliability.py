@@ -634,3 +634,26 @@ def test_a_reader_of_the_messages_that_goes_away_does_not_cost_the_run_its_file(
     out = subprocess.run(cmd, shell=True, executable="/bin/bash", cwd=tmp_path, capture_output=True, text=True,
                          timeout=120)
     assert read_results(tmp_path / "r.h5").status == "complete", out.stdout + out.stderr
+
+
+def test_an_interrupt_while_planning_says_nothing_was_written_and_leaves_an_earlier_file_as_it_was(tmp_path,
+                                                                                                  monkeypatch):
+    """SIGTERM (or Ctrl-C) during auto's proxy runs, before the results file exists, used to exit 130 saying "every
+    accepted step so far is in OUT.h5 … --resume" about a file that did not exist."""
+    import fretsim.runner as runner_module
+
+    def planning(*args, **kwargs):
+        raise KeyboardInterrupt  # as the SIGTERM handler turns the signal into, in a proxy run
+
+    out = tmp_path / "r.h5"
+    monkeypatch.setattr(runner_module, "prepare", planning)
+    r = CliRunner().invoke(main, ["run", CASE, "-o", str(out)])
+    assert r.exit_code == 130 and "nothing was written" in r.output and "--resume" not in r.output, r.output
+    assert not out.exists()
+    monkeypatch.undo()
+    run(load_case(CASE, ["model.dimension=2d", "loading.cycles=200"]), out)
+    before = out.read_bytes()
+    monkeypatch.setattr(runner_module, "prepare", planning)
+    r = CliRunner().invoke(main, ["run", CASE, "-o", str(out), "--overwrite"])
+    assert r.exit_code == 130 and "is as it was" in r.output and "holds the whole run" not in r.output, r.output
+    assert out.read_bytes() == before
