@@ -55,13 +55,17 @@ def _odd(n: float) -> int:
 
 def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float, cycles: int, k_total: float,
               e_star: float, strokes: int = 1, refine: float = 1.0, accuracy: Optional[float] = None,
-              pressure_accuracy: Optional[float] = None, volume: Optional[float] = None) -> Sizing:
+              pressure_accuracy: Optional[float] = None, volume: Optional[float] = None,
+              reach_load: Optional[float] = None) -> Sizing:
     """The paper's element size and a domain holding the estimated final scar (both bodies' volume), plus
     ``strokes`` stroke amplitudes along x (the flat's wear reaches one stroke beyond the contact; seen through
     the stroke average, two).  Given ``accuracy``, the element along x is also at most accuracy/WIDTH_SHARE of
-    the estimated scar width (at most MAX_ACCURACY_REFINEMENT times finer than the paper's)."""
+    the estimated scar width (at most MAX_ACCURACY_REFINEMENT times finer than the paper's).  ``load`` sets the
+    element (a load history's lightest contact, the narrowest to resolve); ``reach_load`` (default ``load``) the
+    domain (its heaviest, the widest to hold: a short history wears too little for the scar to outgrow it)."""
     h = geometry.hertz(load, e_star)
     a = h.half_width_x
+    wide = geometry.hertz(reach_load, e_star) if reach_load is not None and reach_load > load else h
     if volume is None:  # both bodies' worn volume (a load history gives its own sum over the blocks)
         volume = k_total * load * 4 * stroke * cycles
     scar_x, scar_y = geometry.scar_half_widths(volume)
@@ -110,7 +114,7 @@ def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float
                       + (f" (capped at {cap_y:g})" if refine_y == cap_y else "")))
     if refine != 1.0 and why and refine_y == refine:
         why += f"; along y the paper's rule refined ÷ {refine:.3g} for partial slip"
-    reach = SCAR_MARGIN * max(scar_x, a) + strokes * stroke + 3 * dx
+    reach = SCAR_MARGIN * max(scar_x, wide.half_width_x) + strokes * stroke + 3 * dx
     nx = _odd(2 * reach / dx)
     note = (f"dx = {rule} = {dx * 1e3:.3g} µm (a = {a * 1e3:.3g} µm), x extent {nx * dx:.3g} mm for an estimated "
             f"scar half-width {scar_x:.3g} mm")
@@ -121,7 +125,7 @@ def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float
     else:
         scar_y = min(scar_y, 2 * (limits.reach_y or scar_y))
         dy = 7 * h.half_width_y / ELEMENTS_OVER_7A / refine_y
-        ny = _odd(2 * (SCAR_MARGIN * max(scar_y, h.half_width_y) + 3 * dy) / dy)
+        ny = _odd(2 * (SCAR_MARGIN * max(scar_y, wide.half_width_y) + 3 * dy) / dy)
         ly = ny * dy
     return Sizing(a, h.half_width_y, scar_x, (nx * dx, ly), (nx, ny),
                   note + f"; dy = {ly / ny * 1e3:.3g} µm, y extent {ly:.3g} mm", why)

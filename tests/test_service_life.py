@@ -456,3 +456,22 @@ def test_check_sets_the_stroke_of_the_block_nearest_partial_slip_against_its_own
     d_t = float(line.split("δ_t = ")[1].split(" µm")[0])
     ratio = float(line.split(" µm is ")[1].split("×")[0])
     assert "block nearest partial slip 5 µm" in line and ratio == pytest.approx(5.0 / d_t, rel=2e-3), line
+
+
+@pytest.mark.parametrize("loading", [
+    "loading:\n  blocks:\n    - {normal_load: 185 N, stroke: 25 um, cycles: 5}\n"
+    "    - {normal_load: 100 N, stroke: 25 um, cycles: 5}\n",
+    "loading:\n  repeat: 3\n  blocks:\n    - {normal_load: 185 N, stroke: 25 um, cycles: 5}\n"
+    "    - {normal_load: 100 N, stroke: 25 um, cycles: 5}\n",
+    "loading:\n  cycles: 10\n  spectrum:\n    - {normal_load: 185 N, stroke: 25 um, fraction: 0.5}\n"
+    "    - {normal_load: 100 N, stroke: 25 um, fraction: 0.5}\n"], ids=["blocks", "repeat", "spectrum"])
+def test_the_automatic_grid_holds_every_block_s_contact_in_a_short_history(loading):
+    """A valid two-block history of 5 cycles each used to stop at cycle 0, "the contact reached the x edge of the
+    grid", on its own automatic grid: the domain was sized for the lightest block's contact (it sets the element)
+    and a scar too small to outgrow it.  The domain now holds the heaviest block's contact and the stroke."""
+    out = run(case(loading))
+    assert out.status == "complete", out.message
+    g = out.setup.grid
+    from fretsim.reference import effective_modulus
+    a_peak = out.case.geometry.hertz(185.0, effective_modulus(200e3, 0.3, 200e3, 0.3)).half_width_x
+    assert g.x[-1] - g.x[0] >= 2 * (a_peak + 0.025)

@@ -82,7 +82,7 @@ def _sizing(case: Case, contact: Contact, plane: bool, sized: int, refine: float
     def sizing(strokes: int = 1) -> Sizing:
         return auto_grid(case.geometry, plane, loading.lightest_load, loading.peak_stroke, loading.cycles, k_total,
                          contact.e_star, strokes=strokes, refine=refine, accuracy=accuracy,
-                         pressure_accuracy=case.pressure_accuracy, volume=volume)
+                         pressure_accuracy=case.pressure_accuracy, volume=volume, reach_load=loading.peak_load)
 
     first = sizing()
     probe = choose_gap_model(case, Grid.centred(3, 1, first.domain[0] / first.elements[0], 1.0, True))
