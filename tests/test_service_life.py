@@ -475,3 +475,17 @@ def test_the_automatic_grid_holds_every_block_s_contact_in_a_short_history(loadi
     from fretsim.reference import effective_modulus
     a_peak = out.case.geometry.hertz(185.0, effective_modulus(200e3, 0.3, 200e3, 0.3)).half_width_x
     assert g.x[-1] - g.x[0] >= 2 * (a_peak + 0.025)
+
+
+def test_check_counts_the_block_starts_of_a_history_of_short_blocks():
+    """Each block restarts the stepping: 400 one-cycle blocks take a step each, and `check` used to estimate the
+    scheme's ~80 solves for the run's cycles as if it were one block (5 000 × 2 blocks: 93 estimated, minutes
+    run).  The estimate must land within the scheme's usual spread of the steps taken (here within 30 %)."""
+    from fretsim.plan import estimate_solves, prepare
+    for blocks in ((1, 1, 200), (500, 500, 20)):
+        c1, c2, repeat = blocks
+        history = case(f"loading:\n  repeat: {repeat}\n  blocks:\n    - {{normal_load: 185 N, stroke: 25 um, cycles: {c1}}}"
+                       f"\n    - {{normal_load: 100 N, stroke: 25 um, cycles: {c2}}}\n")
+        estimate = estimate_solves(prepare(history)[0])
+        taken = run(history).summary["contact_solves"]
+        assert 0.7 * taken <= estimate <= 1.3 * taken, (blocks, estimate, taken)
