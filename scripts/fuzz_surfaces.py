@@ -1,4 +1,4 @@
-"""Count how hostile inputs end on the surfaces issue #20 names, for a before/after table.
+"""Count how hostile inputs end on the surfaces issues #20 and #31 name, for a before/after table.
 
 For each surface, N random examples (the same ones for every tree: a seeded generator), each judged as
     ok        a sound result (accepted and consistent) or a refusal with a one-paragraph message (exit 2)
@@ -6,9 +6,11 @@ For each surface, N random examples (the same ones for every tree: a seeded gene
     wrong     accepted, but not what was asked for (a roller profile read other than as written)
     hung      still running after HANG seconds
 Surfaces: CSV roller profiles (`fretsim check`), sweep files (`load_sweep`), --dask addresses (the connection
-step, against addresses where nothing listens or nothing is valid).
+step, against addresses where nothing listens or nothing is valid); issue #31's: friction keys, load histories
+and wear limits (`fretsim check`), sampled sweep files (`load_sweep`) and measured CSVs (`fit.read_measured`),
+drawn by tests/hostile.py (the examples the tests draw, from the same seeds).
 
-    python scripts/fuzz_surfaces.py [-n 200] [--tree DIR]   # --tree: another checkout's fretsim, e.g. a worktree
+    python scripts/fuzz_surfaces.py [-n 200] [--tree DIR] [--only 31]   # --tree: another checkout's fretsim
 
 Prints one line per surface.
 """
@@ -68,9 +70,14 @@ def main() -> None:
     ap.add_argument("--dask-n", type=int, default=None, help="examples for --dask (default: -n; an old tree hangs "
                                                                  "on many, each counted after 40 s)")
     ap.add_argument("--tree", default=None, help="a checkout whose fretsim/ to test (default: this one)")
+    ap.add_argument("--only", choices=["20", "31"], default=None, help="one issue's surfaces")
     args = ap.parse_args()
     tree = Path(args.tree or Path(__file__).resolve().parent.parent)
     sys.path.insert(0, str(tree))
+    if args.only != "20":
+        issue_31(args.n, tree)
+    if args.only == "31":
+        return
     from click.testing import CliRunner
 
     from fretsim.case import CaseError
@@ -135,6 +142,70 @@ def main() -> None:
         n = n_dask if surface == "dask addresses" else args.n
         print(f"{surface:15s} {n} examples: {c['ok']} ok, {c['traceback']} tracebacks, {c['wrong']} wrong, "
               f"{c['hang']} hung (> {HANG:g} s)", flush=True)
+
+
+def _attempt(call, counts: dict) -> None:
+    """Run ``call`` (returning "ok" or "traceback") in a thread; counted as hung after HANG seconds."""
+    box = {}
+
+    def attempt():
+        try:
+            box["v"] = call()
+        except Exception:  # noqa: BLE001 - counted
+            box["v"] = "traceback"
+    t = threading.Thread(target=attempt, daemon=True)
+    t.start()
+    t.join(HANG)
+    counts[box.get("v", "hang")] += 1
+
+
+def issue_31(n: int, tree: Path) -> None:
+    """Issue #31's surfaces, each n examples from its own seed (tests/hostile.py draws them)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parent.parent / "tests"))
+    import hostile
+    from click.testing import CliRunner
+
+    from fretsim.case import CaseError
+    from fretsim.cli import main as cli
+    case = str(tree / "cases" / "mccoll_185N.yaml")
+
+    def check(args):
+        return hostile.judge_cli(CliRunner().invoke(cli, ["check", *args]))
+
+    def sets(items):
+        return [a for s in items for a in ("--set", s)]
+
+    def refused_or_read(reader, path):
+        def call():
+            try:
+                reader(path)
+            except CaseError:
+                pass
+            return "ok"
+        return call
+
+    with tempfile.TemporaryDirectory() as tmp:
+        tmp = Path(tmp)
+        from fretsim.fit import read_measured
+        from fretsim.sweep import load_sweep
+        base = (Path(__file__).resolve().parent.parent / "tests" / "test_fuzz_inputs.py").read_text()
+        base = base.split('BASE = """', 1)[1].split('"""', 1)[0]
+        surfaces = {
+            "friction keys": lambda rng: (lambda: check([case, *sets(hostile.friction_example(rng))])),
+            "load histories": lambda rng: ((tmp / "h.yaml").write_text(base + hostile.history_example(rng)),
+                                           lambda: check([str(tmp / "h.yaml")]))[1],
+            "wear limits": lambda rng: (lambda: check([case, *sets(hostile.limits_example(rng))])),
+            "sampled sweeps": lambda rng: ((tmp / "s.yaml").write_text(hostile.sampled_sweep_example(rng, case)),
+                                           refused_or_read(load_sweep, tmp / "s.yaml"))[1],
+            "measured CSVs": lambda rng: ((tmp / "m.csv").write_text(hostile.measured_example(rng)),
+                                          refused_or_read(read_measured, tmp / "m.csv"))[1],
+        }
+        for seed, (surface, example) in enumerate(surfaces.items()):
+            rng, counts = random.Random(seed), {"ok": 0, "traceback": 0, "hang": 0}
+            for _ in range(n):
+                _attempt(example(rng), counts)
+            print(f"{surface:15s} {n} examples: {counts['ok']} ok, {counts['traceback']} tracebacks, {counts['hang']} "
+                  f"hung (> {HANG:g} s)", flush=True)
 
 
 if __name__ == "__main__":
