@@ -170,7 +170,12 @@ SCHEMA: dict[str, dict[str, Key]] = {
                       example="18000"),
         "friction_coefficient": Key("number", "friction coefficient μ (Coulomb): the shear traction |q| ≤ μp of "
                                               "model.slip coulomb, the regime (partial or gross slip) and, for "
-                                              "the uniform model, the energy law and the reported energy", None,
+                                              "the uniform model, the energy law and the reported energy. μ = 0 "
+                                              "is frictionless: no shear traction, nothing sticks (δ_t = 0, gross "
+                                              "slip), every point slides the whole stroke, no energy is dissipated; "
+                                              "auto takes the uniform model, which is exact then, and model.slip "
+                                              "coulomb, model.stroke resolved and the energy law, which have nothing "
+                                              "to work with, are refused", None,
                                     lo=0.0, hi=10.0),
         "blocks": Key("blocks", "a load history instead of one load: a list of blocks, each with normal_load, "
                                 "stroke, cycles (and friction_coefficient where it differs), applied in order; with "

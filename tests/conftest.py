@@ -1,3 +1,4 @@
+import contextlib
 import os
 import shutil
 import sys
@@ -142,3 +143,14 @@ def check_archard_results(res) -> None:
     volumes = [float(np.sum(res.fields[f"wear_depth_{body}"][-1])) * 1e-3 * area for body in ("moving", "stationary")]
     _check_volumes(case, int(res.fields["cycle"][-1]), volumes, res.summary["regime"],
                    res.summary["gross_slip_stroke_um"] * 1e-3)
+
+
+@contextlib.contextmanager
+def edited(path):
+    """A results file opened to be edited on purpose, its whole-file checksum (the user block's) written again
+    afterwards, as a tool that edits knowingly would: what is refused then is what the per-object seals catch."""
+    import h5py
+    from fretsim.results import reseal_file
+    with h5py.File(path, "r+") as f:
+        yield f
+    reseal_file(path)

@@ -14,7 +14,7 @@ import pytest
 from click.testing import CliRunner
 from hypothesis import HealthCheck, given, settings, strategies as st
 
-from conftest import check_archard, check_archard_results
+from conftest import check_archard, check_archard_results, edited
 from fretsim.api import load_case, resume, run
 from fretsim.cli import main
 from fretsim.results import _seal, _verify_seal, read_results
@@ -148,7 +148,7 @@ def test_an_injected_enospc_at_any_flush_leaves_a_valid_file_or_none(tmp_path, m
 def test_a_run_killed_as_it_finished_resumes_to_complete_at_once(tmp_path):
     out = tmp_path / "r.h5"
     run(load_case(CASE, ["model.dimension=2d", "loading.cycles=500"]), out)
-    with h5py.File(out, "r+") as f:  # what a kill between the last flush and the final status leaves
+    with edited(out) as f:  # what a kill between the last flush and the final status leaves
         f.attrs["status"] = "running"
         _seal(f)  # as the writer seals every flush: a killed run's file is a consistent one
     before = read_results(out)
@@ -158,7 +158,7 @@ def test_a_run_killed_as_it_finished_resumes_to_complete_at_once(tmp_path):
     for cycles in ("0",):  # a contact-only run too
         out0 = tmp_path / f"c{cycles}.h5"
         run(load_case(CASE, ["model.dimension=2d", f"loading.cycles={cycles}"]), out0)
-        with h5py.File(out0, "r+") as f:
+        with edited(out0) as f:
             f.attrs["status"] = "interrupted"
             _seal(f)
         assert resume(out0).status == "complete"
@@ -287,7 +287,7 @@ def test_a_coarse_grid_of_a_nanometre_is_refused_by_the_memory_check_not_a_trace
 def good_file(tmp_path_factory):
     path = tmp_path_factory.mktemp("good") / "good.h5"
     run(load_case(CASE, ["model.dimension=2d", "loading.cycles=600"]), path)
-    with h5py.File(path, "r+") as f:
+    with edited(path) as f:
         f.attrs["status"] = "interrupted"  # resumable, so --resume has a checkpoint to verify
         _seal(f)  # as an interrupted run's writer leaves it
     return path
@@ -334,7 +334,7 @@ def test_damage_outside_case_and_checkpoint_is_refused_by_every_command_naming_t
     file with exit 2 and name where it differs."""
     path = tmp_path / "bad.h5"
     path.write_bytes(good_file.read_bytes())
-    with h5py.File(path, "r+") as f:
+    with edited(path) as f:
         where = _damage(kind, f)
     before = path.read_bytes()
     for args in (["summary", str(path), "--json"], ["plot", str(path), "-o", str(tmp_path / "plots")],
@@ -367,16 +367,13 @@ def test_a_flipped_bit_never_resumes_to_other_numbers(tmp_path, good_file, genui
 
 
 @pytest.mark.slow
-@pytest.mark.xfail(strict=True, raises=subprocess.TimeoutExpired,
-                   reason="libhdf5 loops for ever on a global heap whose object sizes disagree (HDFGroup/hdf5#1707), "
-                          "and the reader reads the attributes' checksums from it first")
 def test_a_flipped_bit_in_a_heap_objects_size_is_refused_not_hung_on(tmp_path, good_file):
     """Found when test_mutated_results_files_never_give_a_traceback_or_a_false_complete hung a default run (its
     flips are random): one bit flipped in the size of an object of HDF5's global heap, where the variable-length
     strings are kept (every attrs_sha256 among them), makes `fretsim summary` (and plot, export, --resume) spin at
     100 % CPU for ever instead of refusing the file.  Reproduced here on the middle object of the file's last heap
     collection (bit 6 of its size's second byte: 64 → 16 448 bytes).  A summary takes about a second: 30 s is a
-    hang.  Remove the xfail mark when the reader refuses such a file (exit 2)."""
+    hang.  The whole file's sha256, in an HDF5 user block, is now checked before libhdf5 reads a byte."""
     import re
     data = bytearray(good_file.read_bytes())
     start = [m.start() for m in re.finditer(b"GCOL", data)][-1]  # a collection: "GCOL", version, size, objects
@@ -451,7 +448,7 @@ def test_structurally_damaged_results_files_are_refused_with_the_dataset_named(t
                                                                              kind):
     path = tmp_path / "bad.h5"
     path.write_bytes(good_file.read_bytes())
-    with h5py.File(path, "r+") as f:
+    with edited(path) as f:
         _structural(kind, f)
     _judge(path, tmp_path, genuine_resume)
     with pytest.raises(ValueError) as info:
@@ -489,7 +486,7 @@ def _mutate(src: Path, dst: Path, m) -> None:
         dst.write_bytes(bytes(data))
         return
     dst.write_bytes(bytes(data))
-    with h5py.File(dst, "r+") as f:
+    with edited(dst) as f:
         _structural(m[1], f)
 
 
@@ -499,8 +496,8 @@ def _fuzz(tmp_path, good_file, genuine, m):
     _judge(path, tmp_path, genuine)
 
 
-# Derandomised by default: one flip among the random ones can make libhdf5 loop for ever (the strict xfail
-# above), and a default run must not hang on a rare draw; the slow run below keeps drawing fresh flips.
+# Derandomised by default, so that a default run is the same run every time (a flip into a global heap's object
+# sizes used to make libhdf5 loop for ever: the test above); the slow run below keeps drawing fresh flips.
 @settings(max_examples=30, deadline=None, derandomize=True, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(mutation())
 def test_mutated_results_files_never_give_a_traceback_or_a_false_complete(tmp_path, good_file, genuine_resume, m):
@@ -598,7 +595,7 @@ def test_the_seal_written_from_the_given_values_is_the_seal_read_back(tmp_path, 
     run(load_case(Path(CASE).parent / case, overrides), path)
     copy = tmp_path / "resealed.h5"
     copy.write_bytes(path.read_bytes())
-    with h5py.File(copy, "r+") as f:
+    with edited(copy) as f:
         _seal(f)
     written, read_back = _seals(path), _seals(copy)
     assert len(written) > 100 and written == read_back

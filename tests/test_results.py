@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from conftest import check_archard
+from conftest import check_archard, edited
 from fretsim.api import load_case, run
 from fretsim.case import parse_case
 from fretsim.cli import main
@@ -171,13 +171,13 @@ def test_a_file_with_damaged_inputs_is_refused_and_one_written_without_them_plot
     from fretsim.results import _seal
     path = tmp_path / "d.h5"
     path.write_bytes(Path(results_3d).read_bytes())
-    with h5py.File(path, "r+") as f:
+    with edited(path) as f:
         del f["inputs/stroke"]
         del f["inputs/normal_load"]
         f["inputs/hertz_peak_pressure"][()] = np.nan
     r = CliRunner().invoke(main, ["plot", str(path), "-o", str(tmp_path / "figs"), "--jobs", "1"])
     assert r.exit_code == 2 and "/inputs" in r.output and "checksum" in r.output, r.output
-    with h5py.File(path, "r+") as f:
+    with edited(path) as f:
         _seal(f)
     r = CliRunner().invoke(main, ["plot", str(path), "-o", str(tmp_path / "figs"), "--jobs", "1"])
     assert r.exit_code == 0, r.output
@@ -253,7 +253,7 @@ def test_dimension_is_accepted_in_capitals():
 def test_a_format_1_1_file_is_still_read(results_3d, tmp_path):
     old = tmp_path / "v11.h5"
     old.write_bytes(results_3d.read_bytes())
-    with h5py.File(old, "r+") as f:  # what the 1.1 writer made: none of 1.2's, 1.3's or 1.4's additions
+    with edited(old) as f:  # what the 1.1 writer made: none of 1.2's, 1.3's or 1.4's additions
         for path in ("inputs", "choices", "history/error_estimate_depth", "history/error_estimate_pressure",
                      "fields/x", "fields/y", "history/block", "history/dissipated_energy_J", "history/wear_work",
                      "fields/slip_distance_moving", "fields/slip_distance_stationary", "fields/shear_traction",
@@ -265,7 +265,14 @@ def test_a_format_1_1_file_is_still_read(results_3d, tmp_path):
             for key in ("sha256", "attrs_sha256"):
                 if key in obj.attrs:
                     del obj.attrs[key]
-    res = read_results(old)
+    legacy = tmp_path / "legacy.h5"  # and no user block (the whole-file checksum came later): HDF5 at byte 0
+    with h5py.File(old, "r") as f, h5py.File(legacy, "w") as g:
+        for name in f:
+            f.copy(f[name], g, name=name)
+        for key, value in f.attrs.items():
+            g.attrs[key] = value
+    assert legacy.read_bytes()[:4] == b"\x89HDF"
+    res = read_results(legacy)
     assert res.summary["cycles"] == 1000 and res.inputs == {}
 
 
@@ -282,7 +289,7 @@ def test_a_version_older_than_the_file_never_switches_its_checksums_off(results_
     damage, and a file with checksums is verified whatever its version says."""
     path = tmp_path / "down.h5"
     path.write_bytes(results_3d.read_bytes())
-    with h5py.File(path, "r+") as f:
+    with edited(path) as f:
         f.attrs["format_version"] = version
         d = f["history/max_pressure"]
         d[1] = d[1] * 1.5
@@ -291,7 +298,7 @@ def test_a_version_older_than_the_file_never_switches_its_checksums_off(results_
         r = CliRunner().invoke(main, command)
         assert r.exit_code == 2 and "older than what the file holds" in r.output, (command, r.output)
     assert not (tmp_path / "p.png").exists() and not (tmp_path / "csv").exists()
-    with h5py.File(path, "r+") as f:  # the 1.4 and 1.3 additions gone too: the checksums still hold it
+    with edited(path) as f:  # the 1.4 and 1.3 additions gone too: the checksums still hold it
         del f["history/block"], f["fretting_loop"]
     r = CliRunner().invoke(main, ["summary", str(path)])
     assert r.exit_code == 2 and "checksum" in r.output, r.output
@@ -393,7 +400,7 @@ def test_plot_of_a_run_interrupted_before_its_first_recorded_state_says_what_it_
     """It skipped two figures silently; the history is drawn from the steps, and the wear profiles' absence is said."""
     out = tmp_path / "i.h5"
     run(load_case(CASE, ["model.dimension=2d", "loading.cycles=2000", "output.snapshots=[0, 2000]"]), out)
-    with h5py.File(out, "r+") as f:  # as an interrupted run leaves it: steps past cycle 0, no state recorded yet
+    with edited(out) as f:  # as an interrupted run leaves it: steps past cycle 0, no state recorded yet
         cyc = f["fields/cycle"][()]
         for k in list(f["fields"].keys()):
             ds = f[f"fields/{k}"]

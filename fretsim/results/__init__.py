@@ -49,10 +49,10 @@ from fretsim.results.claim import MAX_NAME, OutputBusy, OutputClaim, check_outpu
 from fretsim.results.layout import (FIELDS, FORMAT_VERSION, HISTORY, NAN_SUMMARY, READABLE_FORMATS, STATUSES,
                                     SUMMARY_UNITS)
 from fretsim.results.reader import Results, read_results, summary_json
-from fretsim.results.seal import _seal, _verify_seal
+from fretsim.results.seal import _seal, _verify_seal, reseal_file
 from fretsim.results.sweep_table import SweepTable, read_sweep_table
 from fretsim.results.writer import ResultsIOError, ResultsWriter
 
 __all__ = ["FIELDS", "FORMAT_VERSION", "HISTORY", "MAX_NAME", "NAN_SUMMARY", "READABLE_FORMATS", "STATUSES",
            "SUMMARY_UNITS", "OutputBusy", "OutputClaim", "Results", "ResultsFileError", "ResultsIOError", "ResultsWriter", "SweepTable",
-           "_seal", "_verify_seal", "check_output_path", "read_results", "read_sweep_table", "summary_json"]
+           "_seal", "_verify_seal", "reseal_file", "check_output_path", "read_results", "read_sweep_table", "summary_json"]

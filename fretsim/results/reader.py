@@ -17,7 +17,8 @@ import numpy as np
 from fretsim.errors import ResultsFileError
 from fretsim.results.layout import (FIELDS, FIELDS_V12, FORMAT_VERSION, HISTORY, HISTORY_V11, HISTORY_V12, HISTORY_V13,
                                     MAX_DATASET_BYTES, NAN_FIELDS, NAN_SUMMARY, READABLE_FORMATS, STATUSES)
-from fretsim.results.seal import SEALED_FROM, _SCALE_ATTRS, _Damaged, _verify_seal, checkpoint_digest, plain, text
+from fretsim.results.seal import (SEALED_FROM, _SCALE_ATTRS, _Damaged, _verify_seal, checkpoint_digest, plain, text,
+                                  verify_image)
 
 
 @dataclass
@@ -160,6 +161,7 @@ def read_results(path: str | Path, for_resume: bool = False) -> Results:
     """
     _regular_file(path)
     try:
+        verify_image(path)  # before HDF5 reads a byte: it can loop for ever on some damaged files
         with h5py.File(path, "r") as f:
             return _read(f, str(path), for_resume)
     except _Damaged as exc:

@@ -20,7 +20,7 @@ import numpy as np
 
 from fretsim import __version__
 from fretsim.results.layout import FIELDS, FORMAT_VERSION, HISTORY, INTEGER_HISTORY, SUMMARY_UNITS, summary_long_name
-from fretsim.results.seal import _SealingWriter, checkpoint_digest
+from fretsim.results.seal import USERBLOCK, _SealingWriter, checkpoint_digest, seal_image
 from fretsim.results.reader import Results
 
 FLUSH_SECONDS = 0.5
@@ -95,9 +95,9 @@ class ResultsWriter:
     def image(self) -> bytes:
         """The whole results file as bytes (an in-memory HDF5 image)."""
         buf = io.BytesIO()
-        with h5py.File(buf, "w") as f:
+        with h5py.File(buf, "w", userblock_size=USERBLOCK) as f:
             self._write(f)
-        return buf.getvalue()
+        return seal_image(buf.getvalue())
 
     def flush(self) -> None:
         """Write the whole file beside the target and move it over the target (atomic); ResultsIOError if the
