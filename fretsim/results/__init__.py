@@ -17,6 +17,8 @@
 
 Format 1.3 seals the rest too: every dataset carries ``sha256`` of its values, every group (and the root)
 ``attrs_sha256`` of its attributes and member names; readers refuse a file that differs, naming where.
+The whole file is sealed too: its first 512 bytes are an HDF5 user block holding the sha256 of the rest, checked
+before libhdf5 reads a byte (it loops for ever on some damaged files); files without one are read as before.
 
 The layout is a contract (README): names are only ever added.  Every dataset has ``units`` and ``long_name``,
 and the dimension scales make ``xarray.open_dataset(path, engine="h5netcdf", group="fields")`` come out
