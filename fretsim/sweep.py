@@ -195,13 +195,7 @@ def _sampled_points(spec, axes, problems: list) -> tuple[dict, list[dict]]:
     """Mode sample: ``spec`` {n, seed} draws of the distributed axes for each combination of the listed ones
     (none while anything in the file is wrong)."""
     from fretsim import uncertainty
-    n = spec.get("n") if isinstance(spec, dict) else None
-    seed = spec.get("seed", 1) if isinstance(spec, dict) else None
-    if not isinstance(spec, dict) or set(spec) - {"n", "seed"} or not isinstance(n, int) or isinstance(n, bool) \
-            or not 1 <= n <= MAX_POINTS or not isinstance(seed, int) or isinstance(seed, bool):
-        problems.append(("sample", f"expected {{n: number of samples (1 to {MAX_POINTS}), seed: a whole number}}, "
-                                   f"got {excerpt(spec)}"))
-        n, seed = 0, 0
+    n, seed = _sample_spec(spec, problems)
     if not isinstance(axes, dict) or not axes:
         problems.append(("axes", "expected a mapping of case keys to distributions (or lists of values)"))
         axes = {}
@@ -226,6 +220,31 @@ def _sampled_points(spec, axes, problems: list) -> tuple[dict, list[dict]]:
         draws = uncertainty.sample(dists, n, seed)
         return axes, [{**dict(zip(lists, combo)), **d} for combo in product(*lists.values()) for d in draws]
     return axes, []
+
+
+def _whole(value) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool)  # YAML's true is an int to Python, not a count
+
+
+def _sample_spec(spec, problems: list) -> tuple[int, int]:
+    """(n, seed) of ``sample:``, each key's problem under its own path; (0, 0) while anything is wrong."""
+    if not isinstance(spec, dict):
+        problems.append(("sample", f"expected {{n: number of samples (1 to {MAX_POINTS}), seed: a whole number "
+                                   f"≥ 0}}, got {excerpt(spec)}"))
+        return 0, 0
+    before = len(problems)
+    for k in spec:
+        if k not in ("n", "seed"):
+            problems.append((f"sample.{str(k)[:40]}", "unknown key; allowed: n, seed"))
+    n, seed = spec.get("n"), spec.get("seed", 1)
+    if not _whole(n) or not 1 <= n <= MAX_POINTS:
+        problems.append(("sample.n", f"{'missing' if 'n' not in spec else f'got {excerpt(n)}'}; expected the number "
+                                     f"of samples, a whole number from 1 to {MAX_POINTS}"))
+    # numpy seeds from non-negative integers only: a negative one is refused here, not by its traceback
+    if not _whole(seed) or seed < 0:
+        problems.append(("sample.seed", f"got {excerpt(seed)}; expected a whole number ≥ 0 (the same seed draws "
+                                        f"the same samples)"))
+    return (n, seed) if len(problems) == before else (0, 0)
 
 
 def _listed_points(listed, problems: list) -> list[dict]:

@@ -471,3 +471,30 @@ def test_a_sweep_over_any_kind_of_quantity_keeps_its_written_unit(tmp_path):
     ds = xr.open_dataset(tmp_path / "o" / "table.h5", engine="h5netcdf")
     axis = ds["loading.tangential_stiffness"]
     assert list(axis.values) == [40.0, 80.0] and axis.attrs["units"] == "N/um"  # the first value's unit
+
+
+SAMPLED = f"""
+base: {CASES / 'mccoll_185N.yaml'}
+set: [model.dimension=2d, loading.cycles=60]
+sample: SAMPLE
+axes:
+  materials.moving.wear_coefficient: {{distribution: lognormal, median: 2e-8 1/MPa, factor: 2}}
+"""
+
+
+@pytest.mark.parametrize("sample, key, expected", [
+    ("{n: 3, seed: -1}", "sample.seed", "≥ 0"),  # was numpy's ValueError traceback
+    ("{n: 3, seed: 1.5}", "sample.seed", "whole number"),
+    ("{n: 3, seed: true}", "sample.seed", "whole number"),
+    ("{n: 0, seed: 1}", "sample.n", "from 1 to 100000"),
+    ("{n: 100001}", "sample.n", "from 1 to 100000"),
+    ("{n: true}", "sample.n", "from 1 to 100000"),
+    ("{seed: 2}", "sample.n", "missing"),
+    ("{n: 3, sed: 1}", "sample.sed", "allowed: n, seed"),
+], ids=["negative-seed", "fractional-seed", "bool-seed", "zero-n", "huge-n", "bool-n", "no-n", "unknown-key"])
+def test_a_bad_sample_key_exits_2_naming_the_file_the_key_and_what_is_accepted(tmp_path, sample, key, expected):
+    path = sweep_file(tmp_path, SAMPLED.replace("SAMPLE", sample))
+    r = CliRunner().invoke(main, ["sweep", str(path), "-o", str(tmp_path / "out")])
+    assert r.exit_code == 2, r.output
+    assert f"{path}: {key}:" in r.output and expected in r.output and "Traceback" not in r.output, r.output
+    assert not (tmp_path / "out").exists()
