@@ -748,7 +748,8 @@ def sweep(sweep_file: Path, outdir: Path, jobs: int, dask_address: str | None, o
     """Run every point of SWEEP_FILE (long-lived workers, or a Dask cluster) and write one table.
 
     Re-running skips complete points and resumes interrupted ones.  Exit 0 when every point completed, 3 when
-    some failed or were refused (see DIR/table.csv), 2 for a bad sweep file, 130 interrupted."""
+    some failed or were refused (see DIR/table.csv), 2 for a bad sweep file, 5 when the disk refused a point's
+    results or the table, 130 interrupted."""
     import os
     for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # before numpy loads: one BLAS
         os.environ.setdefault(var, "1")                                        # thread per worker
@@ -785,11 +786,19 @@ def sweep(sweep_file: Path, outdir: Path, jobs: int, dask_address: str | None, o
     except KeyboardInterrupt:
         raise Fail(f"interrupted; the points done so far are in {outdir} and its table; run the same command again "
                    f"to continue", EXIT_INTERRUPTED) from None
+    except OSError as exc:  # the table (or the directory): the points' own files say how far each got
+        where = f" {exc.filename}" if exc.filename else ""
+        raise Fail(f"cannot write{where}: {exc.strerror or exc}; the points written so far are kept in {outdir}; "
+                   f"run the same command again once there is room", EXIT_IO) from None
     finally:
         if bar is not None:
             bar.__exit__(None, None, None)
     counts = ", ".join(f"{n} {s}" for s, n in sorted(out.counts.items()))
     click.echo(f"{len(out.rows)} points: {counts}. Table: {out.table_csv}, {out.table_h5}")
+    refused = out.counts.get("io_error", 0)
+    if refused:  # as for a run: the disk, not the model, stopped them, and a re-run resumes them
+        raise Fail(f"{refused} point(s) could not write their results (see {out.table_csv}); run the same command "
+                   f"again once there is room", EXIT_IO)
     if not out.all_complete:
         raise Fail(f"not every point completed: see {out.table_csv}", EXIT_FAILED)
 

@@ -525,9 +525,7 @@ def _run_dask(tasks: list, address: str, progress) -> list:
             data = r.pop("data", None)
             out = next(t[4] for t in tasks if t[0] == r["name"])
             if data is not None:
-                tmp = out.with_name(f".{out.name}.part")
-                tmp.write_bytes(data)
-                os.replace(tmp, out)
+                _write_whole(out, data)
             results.append(r)
             if progress is not None:
                 progress(r)
@@ -636,15 +634,45 @@ def _numeric_axis(values: list):
 
 
 def write_table(sweep: Sweep, rows: list, outdir: Path) -> tuple[Path, Path]:
+    """DIR/table.csv and DIR/table.h5 (and a sampled sweep's percentiles.csv), each whole or not at all: a disk
+    that refuses is an OSError naming the file, with no temporary left behind."""
+    csv_path, h5_path = outdir / "table.csv", outdir / "table.h5"
+    _write_csv(csv_path, list(dict.fromkeys(k for r in rows for k in r)), rows)
+    _write_whole(h5_path, _table_image(sweep, rows))
+    if sweep.mode == "sample":
+        write_percentiles(sweep, rows, outdir)
+    return csv_path, h5_path
+
+
+def _write_whole(path: Path, data: bytes) -> None:
+    """``data`` written to a temporary beside ``path`` with plain file I/O and renamed over it.  HDF5 writing to
+    a full disk fails as a RuntimeError from deep in h5py, possibly at close, with its file left behind; built
+    in memory first (as the results writer does), the only writes that can fail are these, as OSErrors."""
+    tmp = path.with_name(f".{path.name}.part")
+    try:
+        with open(tmp, "wb") as fh:
+            fh.write(data)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, path)
+    except OSError as exc:
+        raise OSError(exc.errno, exc.strerror or str(exc), str(path)) from None
+    finally:
+        if tmp.is_file():
+            tmp.unlink()
+
+
+def _table_image(sweep: Sweep, rows: list) -> bytes:
+    """table.h5 as bytes (an in-memory HDF5 image)."""
+    import io
+
     import h5py
     import numpy as np
 
     from fretsim.results import SUMMARY_UNITS
-    csv_path, h5_path = outdir / "table.csv", outdir / "table.h5"
-    _write_csv(csv_path, list(dict.fromkeys(k for r in rows for k in r)), rows)
     outputs = [k for k in SUMMARY_UNITS if any(k in r for r in rows)]
-    tmp = outdir / ".table.h5.part"
-    with h5py.File(tmp, "w") as f:
+    buf = io.BytesIO()
+    with h5py.File(buf, "w") as f:
         f.attrs["sweep"] = json.dumps(sweep.spec())
         text = h5py.string_dtype()
         if sweep.mode == "product":
@@ -683,10 +711,7 @@ def write_table(sweep: Sweep, rows: list, outdir: Path) -> tuple[Path, Path]:
             ds.attrs["units"] = SUMMARY_UNITS.get(name, "")
             if coords:
                 ds.attrs["coordinates"] = coords
-    os.replace(tmp, h5_path)
-    if sweep.mode == "sample":
-        write_percentiles(sweep, rows, outdir)
-    return csv_path, h5_path
+    return buf.getvalue()
 
 
 def write_percentiles(sweep: Sweep, rows: list, outdir: Path) -> Path:
@@ -703,13 +728,9 @@ def write_percentiles(sweep: Sweep, rows: list, outdir: Path) -> Path:
 def _write_csv(path: Path, fields: list, rows: list) -> None:
     """A CSV written whole or not at all (a temporary beside it, renamed over it)."""
     import csv
-    tmp = path.with_name(f".{path.name}.part")
-    try:
-        with open(tmp, "w", newline="") as fh:
-            w = csv.DictWriter(fh, fieldnames=fields)
-            w.writeheader()
-            w.writerows(rows)
-        os.replace(tmp, path)
-    finally:
-        if tmp.is_file():  # a failed write leaves no temporary behind
-            tmp.unlink()
+    import io
+    buf = io.StringIO(newline="")
+    w = csv.DictWriter(buf, fieldnames=fields)
+    w.writeheader()
+    w.writerows(rows)
+    _write_whole(path, buf.getvalue().encode("utf-8"))

@@ -498,3 +498,66 @@ def test_a_bad_sample_key_exits_2_naming_the_file_the_key_and_what_is_accepted(t
     assert r.exit_code == 2, r.output
     assert f"{path}: {key}:" in r.output and expected in r.output and "Traceback" not in r.output, r.output
     assert not (tmp_path / "out").exists()
+
+
+def _unshare_works() -> bool:
+    try:
+        return subprocess.run(["unshare", "-rm", "true"], capture_output=True, timeout=10).returncode == 0
+    except (OSError, subprocess.SubprocessError):
+        return False
+
+
+def _sweep_on_a_refusing_disk(tmp_path, how: str, points_done: bool) -> tuple:
+    """A sampled sweep whose disk refuses writes: a small tmpfs filled up (ENOSPC, where user namespaces let a
+    test mount one) or a file-size limit (EFBIG, anywhere).  With ``points_done`` the points are complete
+    beforehand, so only the table meets the full disk.  Returns (exit code, output, the sweep's directory)."""
+    import resource
+    path = sweep_file(tmp_path, SAMPLED.replace("SAMPLE", "{n: 3, seed: 1}").replace(
+        "loading.cycles=60]", 'loading.cycles=60, "output.snapshots=[60]", grid.error_estimate=none]'))
+    out = tmp_path / "o"
+    # the points' files are ~160 kB each, the table ~35 kB: with the points done only the table meets the full
+    # disk; without, the points do and the table (of their failures) still fits
+    room = 8192 if points_done else 65536
+    if points_done:
+        assert CliRunner().invoke(main, ["sweep", str(path), "-o", str(out), "--jobs", "1"]).exit_code == 0
+        for name in ("table.csv", "table.h5", "percentiles.csv"):
+            (out / name).unlink()
+    command = [sys.executable, "-m", "fretsim", "sweep", str(path), "-o", str(out), "--jobs", "1"]
+    if how == "file-size-limit":
+        def limit():
+            resource.setrlimit(resource.RLIMIT_FSIZE, (room, room))
+        proc = subprocess.run(command, capture_output=True, text=True, preexec_fn=limit, timeout=300)
+        return proc.returncode, proc.stdout + proc.stderr, out
+    if not _unshare_works():
+        pytest.skip("no user namespaces here to mount a small tmpfs")
+    mnt = tmp_path / "mnt"
+    mnt.mkdir()
+    import shlex
+    q = shlex.quote
+    target = mnt / "o"
+    script = "; ".join([
+        f"mount -t tmpfs -o size=1m tmpfs {q(str(mnt))} || exit 99",
+        f"cp -r {q(str(out))} {q(str(target))}" if points_done else "true",
+        f"free=$(df -B1 --output=avail {q(str(mnt))} | tail -1)",
+        f"dd if=/dev/zero of={q(str(mnt / 'filler'))} bs=4096 count=$(( (free - {room}) / 4096 )) 2>/dev/null",
+        " ".join(q(c) for c in [*command[:4], str(path), "-o", str(target), "--jobs", "1"]) + "; rc=$?",
+        f"echo; echo files: $(ls -A {q(str(target))} {q(str(target / 'points'))}); exit $rc"])
+    proc = subprocess.run(["unshare", "-rm", "sh", "-c", script], capture_output=True, text=True, timeout=300)
+    return proc.returncode, proc.stdout + proc.stderr, None
+
+
+@pytest.mark.parametrize("how", ["tmpfs-full", "file-size-limit"])
+def test_a_sweep_whose_table_the_disk_refuses_exits_5_and_leaves_no_temporary(tmp_path, how):
+    """The table was written by HDF5 straight to .table.h5.part: a full disk was h5py's RuntimeError (exit 1)
+    with the temporary left behind."""
+    code, output, out = _sweep_on_a_refusing_disk(tmp_path, how, points_done=True)
+    assert code == 5 and "table.h5" in output and "Traceback" not in output, output
+    assert ".part" not in output if out is None else not list(out.glob("**/*.part")), output
+
+
+@pytest.mark.parametrize("how", ["tmpfs-full", "file-size-limit"])
+def test_a_sweep_whose_points_the_disk_refuses_exits_5_as_a_run_does(tmp_path, how):
+    code, output, out = _sweep_on_a_refusing_disk(tmp_path, how, points_done=False)
+    assert code == 5 and "could not write their results" in output and "Traceback" not in output, output
+    assert ".part" not in output if out is None else not list(out.glob("**/*.part")), output
+
