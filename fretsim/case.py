@@ -894,6 +894,14 @@ def _read_name(r: "_Reader", raw: dict, default_name: str) -> str:
     name = str(name)
     if len(name) > 200:
         r.fail("name", f"a name of {len(name)} characters; at most 200")
+    try:
+        name.encode("utf-8")
+    except UnicodeEncodeError as exc:  # YAML's "\ud800" (a lone surrogate) reads, but no UTF-8 file can hold it
+        given = "" if "name" in raw else " (from the case file's name)"
+        r.fail("name", f"{excerpt(name)}{given} holds a lone surrogate ({name[exc.start]!r} at position "
+                       f"{exc.start}), which is not text and cannot be stored in the results file (UTF-8); expected "
+                       f"a name of Unicode characters")
+        name = "case"
     return name
 
 

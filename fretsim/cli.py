@@ -124,6 +124,8 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
         raise Fail("--resume takes the results file alone: the case, grid and settings are the ones stored in it")
     if resume_file is None and case_file is None:
         raise Fail("give a CASE_FILE to run, or --resume RESULTS_FILE")
+    if case_file is not None:
+        _text_path(case_file, "case file")
     output = resume_file or output or Path(case_file.stem + ".h5")
     progress = _Progress(quiet or not sys.stderr.isatty())
 
@@ -177,6 +179,17 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
         for note in outcome.notes[len(outcome.setup.notes):]:
             click.echo(f"note: {note}", err=True)
     click.echo(_paragraph(outcome))
+
+
+def _text_path(path: Path, what: str) -> None:
+    """A file name that is not text (bytes that are not UTF-8, which Python keeps as lone surrogates) is refused
+    before the run: the results file records the case file's name as UTF-8, and h5py fails on it half-way."""
+    try:
+        str(path).encode("utf-8")
+    except UnicodeEncodeError:
+        shown = os.fsencode(path).decode("utf-8", "backslashreplace")
+        raise Fail(f"{shown}: the {what}'s name is not UTF-8 text, and the results file records it as UTF-8; "
+                   f"rename the file (or copy it to a name of Unicode characters)") from None
 
 
 def _side_runs(before=lambda: None) -> tuple:
@@ -401,6 +414,7 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
 
     from fretsim.api import check as check_case, load_case
 
+    _text_path(case_file, "case file")
     started = time.perf_counter()
     runs, said = _side_runs()
     setup, filled, plan = check_case(load_case(case_file, list(overrides)), runs)

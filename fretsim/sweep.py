@@ -150,6 +150,13 @@ def _read_sweep(path: Path, source: str) -> dict:
 
 def _base(base, path: Path, source: str, problems: list) -> tuple[str, str]:
     """The base case's text and source: a file beside the sweep file, or an inline mapping; ("", "") otherwise."""
+    named = path.parent / base if isinstance(base, str) else path
+    try:
+        str(named).encode("utf-8")  # the base's source: every point's results file records it as UTF-8 text
+    except UnicodeEncodeError:
+        problems.append(("base", f"{excerpt(str(named), 80)}: the {'base case' if named != path else 'sweep'} "
+                                 f"file's name is not UTF-8 text, which the points' results files record; rename it"))
+        return "", ""
     if isinstance(base, str):
         base_path = path.parent / base
         try:

@@ -251,3 +251,29 @@ def test_a_run_after_check_in_one_process_does_not_repeat_autos_proxy_runs():
     checked = len(said)
     out = run(case, runs=runs)
     assert checked >= 4 and len(said) == checked and out.status == "complete", said
+
+
+def test_a_case_name_with_a_lone_surrogate_is_refused_naming_the_file_and_the_key(tmp_path):
+    """YAML's "\\ud800" reads as a lone surrogate, which no UTF-8 file can hold: it was h5py's UnicodeEncodeError
+    half-way into the run."""
+    text = (CASES / "mccoll_185N.yaml").read_text().replace("name: mccoll_185N", 'name: "a\\ud800b"')
+    case = _write(tmp_path, text)
+    for command in (["run", str(case), "-o", str(tmp_path / "r.h5")], ["check", str(case)]):
+        r = CliRunner().invoke(main, command)
+        assert r.exit_code == 2 and f"{case}: name: " in r.output and "lone surrogate" in r.output, r.output
+        assert "Traceback" not in r.output and not (tmp_path / "r.h5").exists(), r.output
+
+
+def test_a_case_file_whose_name_is_not_utf8_is_refused_not_a_traceback(tmp_path):
+    """Its name goes into the results file (/inputs case_file) as UTF-8; bytes that are not reach Python as lone
+    surrogates, and h5py failed on them half-way into the run."""
+    import os
+    try:
+        path = Path(os.fsdecode(os.fsencode(tmp_path) + b"/c\xff.yaml"))
+        path.write_text((CASES / "mccoll_185N.yaml").read_text())
+    except (OSError, UnicodeError):
+        pytest.skip("this file system takes only UTF-8 names")
+    for command in (["run", str(path), "-o", str(tmp_path / "r.h5")], ["check", str(path)]):
+        r = CliRunner().invoke(main, command)
+        assert r.exit_code == 2 and "name is not UTF-8" in r.output and "Traceback" not in r.output, r.output
+        assert not (tmp_path / "r.h5").exists()

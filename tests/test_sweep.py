@@ -561,3 +561,26 @@ def test_a_sweep_whose_points_the_disk_refuses_exits_5_as_a_run_does(tmp_path, h
     assert code == 5 and "could not write their results" in output and "Traceback" not in output, output
     assert ".part" not in output if out is None else not list(out.glob("**/*.part")), output
 
+
+def test_a_sweep_whose_base_name_is_not_utf8_is_refused_before_any_point_runs(tmp_path):
+    """The base's file name goes into every point's results file as UTF-8: every point failed with h5py's
+    UnicodeEncodeError."""
+    try:
+        (Path(os.fsdecode(os.fsencode(tmp_path) + b"/c\xff.yaml"))).write_text(
+            (CASES / "mccoll_185N.yaml").read_text())
+    except (OSError, UnicodeError):
+        pytest.skip("this file system takes only UTF-8 names")
+    path = sweep_file(tmp_path, SMALL.replace(str(CASES / "mccoll_185N.yaml"), '"c\\udcff.yaml"'))
+    r = CliRunner().invoke(main, ["sweep", str(path), "-o", str(tmp_path / "out")])
+    assert r.exit_code == 2 and f"{path}: base: " in r.output and "not UTF-8" in r.output, r.output
+    assert not (tmp_path / "out").exists()
+
+
+def test_a_sweep_whose_base_names_a_lone_surrogate_is_refused_before_any_point_runs(tmp_path):
+    """Every point failed with h5py's UnicodeEncodeError (exit 3) where the name check now refuses the file."""
+    (tmp_path / "b.yaml").write_text((CASES / "mccoll_185N.yaml").read_text().replace("name: mccoll_185N",
+                                                                                      'name: "a\\ud800b"'))
+    path = sweep_file(tmp_path, SMALL.replace(str(CASES / "mccoll_185N.yaml"), "b.yaml"))
+    r = CliRunner().invoke(main, ["sweep", str(path), "-o", str(tmp_path / "out")])
+    assert r.exit_code == 2 and "name: " in r.output and "lone surrogate" in r.output, r.output
+    assert not (tmp_path / "out").exists()
