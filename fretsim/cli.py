@@ -125,7 +125,10 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
     if resume_file is None and case_file is None:
         raise Fail("give a CASE_FILE to run, or --resume RESULTS_FILE")
     if case_file is not None:
+        _not_results(case_file)
         _text_path(case_file, "case file")
+    if resume_file is not None:
+        _case_not_results(resume_file, "run --resume")
     output = resume_file or output or Path(case_file.stem + ".h5")
     progress = _Progress(quiet or not sys.stderr.isatty())
 
@@ -179,6 +182,57 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
         for note in outcome.notes[len(outcome.setup.notes):]:
             click.echo(f"note: {note}", err=True)
     click.echo(_paragraph(outcome))
+
+
+HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
+
+
+def _is_hdf5(path: Path) -> bool:
+    """Whether ``path`` is a regular file with HDF5's signature (at offset 0, or after a user block of 512 · 2ⁿ
+    bytes), read from a few bytes: `check` and `summary` must not pay for importing h5py to say so."""
+    try:
+        if not path.is_file():  # a FIFO would block the open
+            return False
+        with open(path, "rb") as fh:
+            for offset in (0, 512, 1024, 2048, 4096):
+                fh.seek(offset)
+                if fh.read(8) == HDF5_SIGNATURE:
+                    return True
+    except OSError:
+        return False
+    return False
+
+
+def _not_results(path: Path) -> None:
+    """A results file given where a case (YAML) is expected: say what it is and what reads it, rather than that it
+    is not UTF-8 text or is megabytes long."""
+    if not _is_hdf5(path):
+        return
+    status = _status_of(path)
+    if status is None:
+        raise Fail(f"{path} is an HDF5 file, not a case (YAML); a case file is the YAML text `fretsim init` writes")
+    resume = f"continue it with `fretsim run --resume {path}`, or " if status in ("interrupted", "running") else ""
+    raise Fail(f"{path} is a results file (HDF5, status {status!r}), not a case (YAML): {resume}read it with "
+               f"`fretsim summary {path}` or `fretsim plot {path}`; its case is inside it (/case)")
+
+
+def _case_not_results(path: Path, command: str) -> None:
+    """A case (YAML) given where a results file is expected: say which command makes one (ResultsFileError, so
+    that `summary` of several files lists it among the unreadable ones)."""
+    if _is_hdf5(path) or not path.is_file() or path.suffix.lower() not in (".yaml", ".yml"):
+        return  # the reader's own message then says what is wrong
+    if command == "run --resume":
+        raise ResultsFileError(f"{path} is a case file (YAML): --resume continues an interrupted run from its "
+                               f"results file (HDF5); to run the case, `fretsim run {path}`")
+    raise ResultsFileError(f"{path} is a case file (YAML), not a results file: `fretsim {command}` reads the HDF5 "
+                           f"files that `fretsim run` writes; run it first with `fretsim run {path}` (which writes "
+                           f"{Path(path.stem + '.h5')}), then `fretsim {command} {Path(path.stem + '.h5')}`")
+
+
+def _read_results(path: Path, command: str):
+    from fretsim.results import read_results
+    _case_not_results(Path(path), command)
+    return read_results(path)
 
 
 def _text_path(path: Path, what: str) -> None:
@@ -414,6 +468,7 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
 
     from fretsim.api import check as check_case, load_case
 
+    _not_results(case_file)
     _text_path(case_file, "case file")
     started = time.perf_counter()
     runs, said = _side_runs()
@@ -504,7 +559,7 @@ def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> N
     sweep's directory stands for its points."""
     import json
 
-    from fretsim.results import read_results, summary_json
+    from fretsim.results import summary_json
 
     if as_json and as_csv:
         raise Fail("--json and --csv are two formats of the same figures; choose one")
@@ -512,7 +567,7 @@ def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> N
     rows, bad = [], []
     for path in results_files:
         try:
-            rows.append(summary_json(read_results(path)))
+            rows.append(summary_json(_read_results(path, "summary")))
         except ResultsFileError as exc:
             if len(results_files) == 1:
                 raise
@@ -575,12 +630,10 @@ def plot(results_files: tuple, outdir: Path | None, fmt: str, dpi: int, log_cycl
     pressure profiles with the initial Hertz solution, depth and volume against cycles.  Given several files
     (or --expected): one overlay.png of their worn profiles and depth histories on common axes.  Given a
     sweep's directory: response curves, each output against each swept axis, one line per value of the others."""
-    from fretsim.results import read_results
-
     if len(results_files) > 1 or expected:
         if any(p.is_dir() for p in results_files):
             raise Fail("overlaying takes results files, not a sweep's directory (plot that alone)")
-        runs = [read_results(p) for p in results_files]
+        runs = [_read_results(p, "plot") for p in results_files]
         from fretsim.plotting import plot_overlay
         _write_and_list(lambda: plot_overlay(runs, outdir or results_files[0].parent, expected, fmt, dpi),
                         "the overlay")
@@ -594,7 +647,7 @@ def plot(results_files: tuple, outdir: Path | None, fmt: str, dpi: int, log_cycl
         _write_and_list(lambda: plot_sweep(table, outdir or results_file, fmt=fmt, dpi=dpi), "figures")
         return
 
-    res = read_results(results_file)
+    res = _read_results(results_file, "plot")
     from fretsim.plotting import plot_all, skipped
     for why in skipped(res):
         click.echo(f"note: {why}", err=True)
@@ -622,9 +675,8 @@ def _write_and_list(write, what: str) -> None:
 def export(results_file: Path, csv_dir: Path, debug: bool) -> None:
     """Write RESULTS_FILE as CSV files for spreadsheets (units in the column names)."""
     from fretsim.export import export_csv
-    from fretsim.results import read_results
 
-    res = read_results(results_file)
+    res = _read_results(results_file, "export")
     _write_and_list(lambda: export_csv(res, csv_dir), str(csv_dir))
 
 

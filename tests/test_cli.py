@@ -277,3 +277,38 @@ def test_a_case_file_whose_name_is_not_utf8_is_refused_not_a_traceback(tmp_path)
         r = CliRunner().invoke(main, command)
         assert r.exit_code == 2 and "name is not UTF-8" in r.output and "Traceback" not in r.output, r.output
         assert not (tmp_path / "r.h5").exists()
+
+
+def _interrupted(path: Path, at_cycle: int = 0) -> Path:
+    """A 2D run stopped as Ctrl-C stops it, after its first step past ``at_cycle``: its file says 'interrupted'."""
+    from fretsim.api import load_case, run
+
+    class Stop:
+        def on_step(self, setup, step):
+            if step.cycle > at_cycle:
+                raise KeyboardInterrupt
+    with pytest.raises(KeyboardInterrupt):
+        run(load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", "loading.cycles=500"]), path,
+            observers=(Stop(),))
+    return path
+
+
+@pytest.mark.parametrize("command", ["run", "check"])
+def test_a_results_file_given_as_a_case_is_named_for_what_it_is_with_the_commands_that_read_it(tmp_path, command):
+    """It was 'the case file is not UTF-8 text (byte 0)', or for a large one 'the case file is 7.5 MB'."""
+    results = _interrupted(tmp_path / "r.h5")
+    r = CliRunner().invoke(main, [command, str(results)])
+    assert r.exit_code == 2 and "Traceback" not in r.output, r.output
+    assert f"{results} is a results file (HDF5, status 'interrupted')" in r.output, r.output
+    assert f"fretsim run --resume {results}" in r.output and f"fretsim summary {results}" in r.output, r.output
+
+
+@pytest.mark.parametrize("command", [["plot"], ["summary"], ["export", "--csv", "csv"], ["run", "--resume"]],
+                         ids=["plot", "summary", "export", "resume"])
+def test_a_case_given_where_a_results_file_is_expected_says_to_run_it_first(cli, tmp_path, command):
+    """It was the reader's 'not a readable fretsim results file (OSError: … file signature not found)'."""
+    case = _write(tmp_path, (CASES / "mccoll_185N.yaml").read_text())
+    r = cli.invoke(main, [*command, str(case)])
+    assert r.exit_code == 2 and "Traceback" not in r.output and "signature" not in r.output, r.output
+    assert f"{case} is a case file (YAML)" in r.output and f"`fretsim run {case}`" in r.output, r.output
+    assert not (tmp_path / "csv").exists()
