@@ -634,7 +634,10 @@ def plot(results_files: tuple, outdir: Path | None, fmt: str, dpi: int, log_cycl
         if any(p.is_dir() for p in results_files):
             raise Fail("overlaying takes results files, not a sweep's directory (plot that alone)")
         runs = [_read_results(p, "plot") for p in results_files]
-        from fretsim.plotting import plot_overlay
+        from fretsim.plotting import plot_overlay, run_status
+        for p, res in zip(results_files, runs):
+            if run_status(res):  # drawn as far as it got, and marked so in the legend
+                click.echo(f"note: {p}: {run_status(res)}; drawn as far as it got", err=True)
         _write_and_list(lambda: plot_overlay(runs, outdir or results_files[0].parent, expected, fmt, dpi),
                         "the overlay")
         return

@@ -203,6 +203,20 @@ def plot_all(res: Results, outdir: str | Path, fmt: str = "png", dpi: int = 150,
 EXPECTED_MARKERS = {"experiment": "o", "fea": "s", "paper": "^"}
 
 
+def run_status(res: Results) -> str:
+    """How far a run that did not complete got ("interrupted at cycle 1 200 of 500 000"), "" for a complete one:
+    an overlay draws every file alike, and a run cut short looks like one with less wear."""
+    if res.status == "complete":
+        return ""
+    cycles = res.history.get("cycle")
+    reached = int(cycles[-1]) if cycles is not None and len(cycles) else 0
+    asked = _float(res, "cycles")
+    where = f"at cycle {reached:,}".replace(",", " ") + (f" of {asked:,.0f}".replace(",", " ") if asked else "")
+    said = {"interrupted": "interrupted", "failed": "failed", "stopped": "stopped at a physical limit",
+            "running": "unfinished (status running: still running, or killed)"}
+    return f"{said.get(res.status, f'status {res.status!r}')} {where}"
+
+
 def overlay(results: list, expected: bool = False):
     """Several runs on one figure, as the paper compares RT with 90 °C and runs with and without jumping: the
     final worn profiles of both bodies across the contact, and each body's maximum depth against cycles; with
@@ -210,7 +224,8 @@ def overlay(results: list, expected: bool = False):
     fig, axes = plt.subplots(2, 2, figsize=(12, 8), squeeze=False)
     shown = set()  # published values are the case's: drawn once per case, in black
     for k, res in enumerate(results):
-        label = f"{res.attrs.get('case_name', '')} ({Path(res.path).stem})"
+        status = run_status(res)
+        label = f"{res.attrs.get('case_name', '')} ({Path(res.path).stem}{', ' + status if status else ''})"
         colour = f"C{k % 10}"
         last = len(res.fields["cycle"]) - 1
         for col, body in enumerate(("stationary", "moving")):
