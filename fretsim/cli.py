@@ -110,7 +110,8 @@ def _duration(seconds: float) -> str:
 @click.option("--overwrite", is_flag=True, help="Replace an existing results file.")
 @click.option("--resume", "resume_file", type=click.Path(path_type=Path),
               help="Continue an interrupted run from its results file (no CASE_FILE then).")
-@click.option("--quiet", is_flag=True, help="No notes, no progress bar; the summary paragraph only.")
+@click.option("--quiet", is_flag=True, help="No notes, no progress bar: the summary paragraph, and the warnings "
+              "(a model out of its range, an estimated error above model.accuracy), which always print.")
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
 @_boundary
 def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite: bool, resume_file: Path | None,
@@ -136,9 +137,10 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
         raise KeyboardInterrupt
 
     def _on_plan(setup, filled, plan):
-        if not quiet:
-            for note in setup.notes:  # the plan's warnings as check shows them: the model may be out of its range
+        for note in setup.notes:  # the plan's warnings as check shows them: the model may be out of its range
+            if note in plan.warnings or not quiet:  # a warning is about the results, not progress: --quiet keeps it
                 click.echo(f"{'warning' if note in plan.warnings else 'note'}: {note}", err=True)
+        if not quiet:
             long = long_run_note(setup)
             if long:
                 click.echo(long, err=True)
@@ -178,10 +180,18 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
     if outcome.status != "complete":
         raise Fail(f"run failed: {outcome.message}" + (f"; steps up to the failure are in {output} (status 'failed')"
                                                        if outcome.written else ""), EXIT_FAILED)
-    if not quiet:
-        for note in outcome.notes[len(outcome.setup.notes):]:
+    for note in outcome.notes[len(outcome.setup.notes):]:
+        if _beyond_accuracy(note):  # the results are less accurate than asked: said even with --quiet
+            click.echo(f"warning: {note}", err=True)
+        elif not quiet:
             click.echo(f"note: {note}", err=True)
     click.echo(_paragraph(outcome))
+
+
+def _beyond_accuracy(note: str) -> bool:
+    """A run's note that an estimated error exceeds model.accuracy or model.pressure_accuracy (the runner's
+    words), as opposed to how the estimates were made."""
+    return "exceeds model.accuracy" in note or "exceeds model.pressure_accuracy" in note
 
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"

@@ -312,3 +312,27 @@ def test_a_case_given_where_a_results_file_is_expected_says_to_run_it_first(cli,
     assert r.exit_code == 2 and "Traceback" not in r.output and "signature" not in r.output, r.output
     assert f"{case} is a case file (YAML)" in r.output and f"`fretsim run {case}`" in r.output, r.output
     assert not (tmp_path / "csv").exists()
+
+
+def test_quiet_still_warns_that_an_estimated_error_exceeds_model_accuracy(tmp_path):
+    """60 cycles on the automatic 2D grid estimate the scar width to about 2 %, over the case's 1 %: --quiet (no
+    notes, no progress) hid that warning, which is about the results, not the run's progress."""
+    args = ["run", str(CASES / "mccoll_185N.yaml"), "--set", "model.dimension=2d", "--set", "loading.cycles=60",
+            "--set", "output.snapshots=[60]"]
+    loud = CliRunner().invoke(main, [*args, "-o", str(tmp_path / "loud.h5")])
+    quiet = CliRunner().invoke(main, [*args, "-o", str(tmp_path / "quiet.h5"), "--quiet"])
+    assert loud.exit_code == 0 and quiet.exit_code == 0, (loud.output, quiet.output)
+    warning = [line for line in loud.stderr.splitlines() if "exceeds model.accuracy" in line]
+    assert len(warning) == 1 and warning[0].startswith("warning: the estimated error of"), loud.stderr
+    assert warning[0] in quiet.stderr.splitlines(), quiet.stderr
+    assert "note:" not in quiet.stderr and "note:" in loud.stderr  # the rest of what --quiet hides stays hidden
+    assert quiet.stdout.startswith("mccoll_185N: 60 cycles") and "warning" not in quiet.stdout, quiet.stdout
+
+
+def test_quiet_still_warns_where_the_model_is_out_of_its_range(tmp_path):
+    """The plan's warnings (here: Hertz's p0 past the onset of yield) say the results may not hold: not progress."""
+    r = CliRunner().invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), "--set", "model.dimension=2d", "--set",
+                                  "loading.cycles=60", "--set", "output.snapshots=[60]", "--set",
+                                  "materials.moving.yield_strength=100 MPa", "-o", str(tmp_path / "r.h5"), "--quiet"])
+    assert r.exit_code == 0, r.output
+    assert "warning: the Hertz peak pressure p0 = 328.4 MPa passes the onset of yield" in r.stderr, r.stderr
