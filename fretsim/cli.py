@@ -866,9 +866,11 @@ def sweep(sweep_file: Path, outdir: Path, jobs: int, dask_address: str | None, o
         raise Fail(f"interrupted; the points done so far are in {outdir} and its table; run the same command again "
                    f"to continue", EXIT_INTERRUPTED) from None
     except OSError as exc:  # the table (or the directory): the points' own files say how far each got
+        import errno
         where = f" {exc.filename}" if exc.filename else ""
+        when = " once there is room" if exc.errno in (errno.ENOSPC, errno.EDQUOT) else ""
         raise Fail(f"cannot write{where}: {exc.strerror or exc}; the points written so far are kept in {outdir}; "
-                   f"run the same command again once there is room", EXIT_IO) from None
+                   f"run the same command again{when}", EXIT_IO) from None
     finally:
         if bar is not None:
             bar.__exit__(None, None, None)
