@@ -246,6 +246,16 @@ class _Sink:
             _restore_signals(previous)
 
 
+def _io_outcome(exc, sink: "_Sink", setup, filled, plan, counter, t0) -> Outcome:
+    """A disk that refused the results: what the file on disk holds (the last flush that went through), or that
+    nothing was written (the disk refused the first, at the run's end for a short run: it said "cycle None")."""
+    cycle, output = sink.cycle_on_disk(), sink.output
+    where = (f"the file holds every step up to cycle {cycle} (status 'running'); when there is room, continue with "
+             f"`fretsim run --resume {output}`" if cycle is not None else "nothing was written")
+    return Outcome("io_error", f"{exc.strerror}; {where}", _summary(setup, counter, t0), setup, filled, Path(output),
+                   counter.last, setup.notes, plan, cycle is not None)
+
+
 def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from: Optional[Results],
              runs: SideRuns) -> Outcome:
     counter = _Counter(len(resume_from.history["cycle"]) if resume_from is not None else 0,
@@ -256,11 +266,7 @@ def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from:
     try:
         status, message = _simulate(setup, filled, plan, counter, sink, observers, progress, state)
     except ResultsIOError as exc:
-        cycle = sink.cycle_on_disk()
-        where = (f"the file holds every step up to cycle {cycle} (status 'running'); when there is room, continue "
-                 f"with `fretsim run --resume {output}`" if cycle is not None else "nothing was written")
-        return Outcome("io_error", f"{exc.strerror}; {where}", _summary(setup, counter, t0), setup, filled,
-                       Path(output), counter.last, setup.notes, plan, cycle is not None)
+        return _io_outcome(exc, sink, setup, filled, plan, counter, t0)
     except KeyboardInterrupt:
         sink.finish_interrupted(counter, t0, lambda: f"interrupted after cycle "
                                 f"{counter.last.cycle if counter.last else (int(state['n']) if state else 0)}; "
@@ -272,11 +278,7 @@ def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from:
     try:
         sink.finish(counter, t0, status, message)
     except ResultsIOError as exc:
-        cycle = sink.cycle_on_disk()
-        return Outcome("io_error", f"{exc.strerror}; the file holds every step up to cycle {cycle} (status "
-                                   f"'running'); when there is room, continue with `fretsim run --resume {output}`",
-                       _summary(setup, counter, t0), setup, filled, Path(output), counter.last, setup.notes, plan,
-                       True)
+        return _io_outcome(exc, sink, setup, filled, plan, counter, t0)
     finally:
         _restore_signals(previous)
     return Outcome(status, message, _summary(setup, counter, t0), setup, filled, Path(output) if output else None,

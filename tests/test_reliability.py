@@ -654,3 +654,19 @@ def test_an_interrupt_while_planning_says_nothing_was_written_and_leaves_an_earl
     r = CliRunner().invoke(main, ["run", CASE, "-o", str(out), "--overwrite"])
     assert r.exit_code == 130 and "is as it was" in r.output and "holds the whole run" not in r.output, r.output
     assert out.read_bytes() == before
+
+
+def test_a_disk_that_refuses_a_short_run_s_only_write_says_nothing_was_written(tmp_path, monkeypatch):
+    """A run short enough to be written once, at its end, onto a disk that refuses it: the message used to say "the
+    file holds every step up to cycle None (status 'running')" and suggest --resume of a file that was not there."""
+    import fretsim.results.writer as results_module
+
+    def refuse(self):
+        raise results_module.ResultsIOError(errno.ENOSPC, f"cannot write {self.path}: the disk is full")
+
+    monkeypatch.setattr(results_module.ResultsWriter, "flush", refuse)
+    out = tmp_path / "r.h5"
+    outcome = run(load_case(CASE, ["model.dimension=2d", "loading.cycles=10", "grid.error_estimate=none"]), out)
+    assert outcome.status == "io_error" and not outcome.written, outcome.message
+    assert "nothing was written" in outcome.message and "None" not in outcome.message, outcome.message
+    assert list(tmp_path.iterdir()) == []
