@@ -336,3 +336,20 @@ def test_quiet_still_warns_where_the_model_is_out_of_its_range(tmp_path):
                                   "materials.moving.yield_strength=100 MPa", "-o", str(tmp_path / "r.h5"), "--quiet"])
     assert r.exit_code == 0, r.output
     assert "warning: the Hertz peak pressure p0 = 328.4 MPa passes the onset of yield" in r.stderr, r.stderr
+
+
+def test_a_fault_composing_the_paragraph_after_a_complete_run_never_turns_it_into_a_failure(tmp_path, monkeypatch):
+    """μ = 0 once divided by δ_t = 0 in the paragraph, after the run had written a complete file: exit 1 and a
+    traceback.  Whatever goes wrong in composing it, the run's exit code and file stand."""
+    import fretsim.cli as cli_module
+
+    def broken(*args):
+        raise ZeroDivisionError("float division by zero")
+
+    monkeypatch.setattr(cli_module, "_regime", broken)
+    out = tmp_path / "r.h5"
+    r = CliRunner().invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), "-o", str(out), "--set",
+                                  "model.dimension=2d", "--set", "loading.cycles=100", "--set",
+                                  "grid.error_estimate=none"])
+    assert r.exit_code == 0 and "fretsim summary" in r.output and "Traceback" not in r.output, r.output
+    assert read_results(out).status == "complete"
