@@ -852,6 +852,9 @@ def sweep(sweep_file: Path, outdir: Path, jobs: int, dask_address: str | None, o
 
     def _checking(done, total):  # a large sweep takes seconds to check: say so
         click.echo(f"checking the sweep's points: {done} of {total}", err=True)
+    if _is_hdf5(Path(sweep_file)):  # a sweep's table.h5 or a run's results: not a sweep file
+        raise Fail(f"{sweep_file} is an HDF5 file (a results file or a sweep's table), not a sweep file (YAML): "
+                   f"`fretsim plot` and `fretsim summary` read it; a sweep file lists base, set and axes")
     spec = load_sweep(sweep_file, progress=_checking)
     failures = {"n": 0}
     bar = None

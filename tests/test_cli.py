@@ -303,6 +303,14 @@ def test_a_results_file_given_as_a_case_is_named_for_what_it_is_with_the_command
     assert f"fretsim run --resume {results}" in r.output and f"fretsim summary {results}" in r.output, r.output
 
 
+def test_a_results_file_given_as_a_sweep_file_is_named_for_what_it_is(tmp_path):
+    """It was 'the sweep file is not UTF-8 text'."""
+    results = _interrupted(tmp_path / "r.h5")
+    r = CliRunner().invoke(main, ["sweep", str(results), "-o", str(tmp_path / "out")])
+    assert r.exit_code == 2 and "is an HDF5 file" in r.output and "not UTF-8" not in r.output, r.output
+    assert not (tmp_path / "out").exists()
+
+
 @pytest.mark.parametrize("command", [["plot"], ["summary"], ["export", "--csv", "csv"], ["run", "--resume"]],
                          ids=["plot", "summary", "export", "resume"])
 def test_a_case_given_where_a_results_file_is_expected_says_to_run_it_first(cli, tmp_path, command):
