@@ -705,6 +705,20 @@ def export(results_file: Path, csv_dir: Path, debug: bool) -> None:
     _write_and_list(lambda: export_csv(res, csv_dir), str(csv_dir))
 
 
+def _not_an_input(output: Path, inputs: dict) -> None:
+    """Refuse an output that is one of the command's inputs, by path or by inode (a hard link, a symbolic link
+    to it): writing it would replace what the command read, and the next run would read the replacement."""
+    for what, path in inputs.items():
+        same = os.path.abspath(output) == os.path.abspath(path)
+        try:
+            same = same or os.path.samefile(output, path)
+        except OSError:  # one of them does not exist (yet): then they are not one file
+            pass
+        if same:
+            raise Fail(f"-o {output} is the {what} this fit reads ({path}); writing the fitted case there would "
+                       f"replace it: choose another name for the fitted case")
+
+
 @main.command()
 @click.argument("case_file", type=click.Path(path_type=Path))
 @click.option("--measured", "measured_file", required=True, type=click.Path(path_type=Path),
@@ -727,6 +741,8 @@ def fit(case_file: Path, measured_file: Path, fit_keys: tuple, overrides: tuple,
     from fretsim.units import INTERNAL
     from fretsim.yamlread import read_text
 
+    if output is not None:
+        _not_an_input(output, {"case file": case_file, "measured file": measured_file})
     text = read_text(case_file, "case file")
     measured = read_measured(measured_file)
     click.echo(f"fitting {', '.join(fit_keys or DEFAULT_FIT)} to {measured.values.size} measured value(s) of "

@@ -1,0 +1,82 @@
+"""`fretsim fit` refuses what it cannot fit, each with its reason, and never hangs, overwrites its inputs or loses
+the settings it fitted under (issue 31, part three)."""
+import os
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+from click.testing import CliRunner
+
+from fretsim.api import load_case, run
+from fretsim.cli import main
+from fretsim.export import export_csv
+from fretsim.fit import fit, read_measured
+from fretsim.results import read_results
+
+CASES = Path(__file__).resolve().parent.parent / "cases"
+CASE = CASES / "mccoll_185N.yaml"
+TWO_D = "model.dimension=2d"
+K_MOVING, K_STATIONARY = 3e-8, 1.2e-8  # the truth the synthetic measurements come from
+TRUTH = [TWO_D, f"materials.moving.wear_coefficient={K_MOVING} 1/MPa",
+         f"materials.stationary.wear_coefficient={K_STATIONARY} 1/MPa", "output.snapshots=[3000, 9000, 18000]",
+         "grid.error_estimate=none", "jumping.tolerance=1e-3"]
+DEPTHS = "cycle [cycles],max_wear_depth_moving [um],max_wear_depth_stationary [um]"
+
+
+@pytest.fixture(scope="session")  # per worker, once
+def truth(tmp_path_factory):
+    """A 2D run with known coefficients, its depths at three cycles (measured.csv) and its exported CSVs."""
+    tmp = tmp_path_factory.mktemp("fit_truth")
+    run(load_case(CASE, TRUTH), tmp / "truth.h5")
+    res = read_results(tmp / "truth.h5")
+    lines = [DEPTHS]
+    for i, c in enumerate(res.fields["cycle"]):
+        if c:
+            lines.append(f"{c},{res.fields['wear_depth_moving'][i].max():.5g},"
+                         f"{res.fields['wear_depth_stationary'][i].max():.5g}")
+    (tmp / "measured.csv").write_text("\n".join(lines) + "\n")
+    export_csv(res, tmp / "export")
+    return tmp
+
+
+def fit_cli(*args, timeout=None):
+    """The command in a subprocess (a hang is a failure after ``timeout`` s, not a stuck suite)."""
+    env = {**os.environ, "PYTHONPATH": str(Path(__file__).resolve().parent.parent)}
+    return subprocess.run([sys.executable, "-m", "fretsim", "fit", *map(str, args)], capture_output=True,
+                          text=True, timeout=timeout, env=env)
+
+
+def refused(r, *words):
+    out = r.output if hasattr(r, "output") else r.stdout + r.stderr
+    code = r.exit_code if hasattr(r, "exit_code") else r.returncode
+    assert code == 2, out
+    assert "Traceback" not in out, out
+    for w in words:
+        assert w in out, (w, out)
+    return out
+
+
+# --- 1. -o never names an input ------------------------------------------------------------------------------------
+
+def test_fit_refuses_an_output_that_is_its_measured_file_and_leaves_the_measurements(truth, tmp_path):
+    measured = tmp_path / "m.csv"
+    measured.write_bytes((truth / "measured.csv").read_bytes())
+    before = measured.read_bytes()
+    r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(measured), "--set", TWO_D, "-o",
+                                  str(measured)])
+    refused(r, "measured file")
+    assert measured.read_bytes() == before
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m.csv"]
+
+
+def test_fit_refuses_an_output_that_is_its_case_file_under_another_name(truth, tmp_path):
+    """A hard link is the same file by another name: the same inode is refused, not only the same path."""
+    case = tmp_path / "case.yaml"
+    case.write_bytes(CASE.read_bytes())
+    os.link(case, tmp_path / "alias.yaml")
+    r = CliRunner().invoke(main, ["fit", str(case), "--measured", str(truth / "measured.csv"), "--set", TWO_D,
+                                  "-o", str(tmp_path / "alias.yaml")])
+    refused(r, "case file")
+    assert case.read_bytes() == CASE.read_bytes()
