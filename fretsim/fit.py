@@ -153,7 +153,7 @@ def _data(rows: list[list[str]], columns: list[tuple], profile: bool, problems: 
         except (KeyError, ValueError):
             problems.append((f"row {i}", f"cycle {cells.get('cycle')!r} is not a number"))
             continue
-        if not (n > 0 and n == int(n)):
+        if not (math.isfinite(n) and n > 0 and n == int(n)):  # int() of inf raises, of nan too
             problems.append((f"row {i}", f"cycle {cells['cycle']!r}: expected a whole number of cycles above 0"))
             continue
         x = float("nan")

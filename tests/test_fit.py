@@ -80,3 +80,13 @@ def test_fit_refuses_an_output_that_is_its_case_file_under_another_name(truth, t
                                   "-o", str(tmp_path / "alias.yaml")])
     refused(r, "case file")
     assert case.read_bytes() == CASE.read_bytes()
+
+
+# --- 2. a cycle that is no whole number ----------------------------------------------------------------------------
+
+@pytest.mark.parametrize("cycle", ["inf", "-inf", "nan", "1e400", "2.5", "0.5"])
+def test_a_measured_cycle_that_is_not_a_whole_number_above_0_is_refused_naming_its_row(tmp_path, cycle):
+    path = tmp_path / "m.csv"
+    path.write_text(f"cycle [cycles],max_wear_depth_stationary [um]\n1000,0.1\n{cycle},1\n")
+    r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(path)])
+    refused(r, str(path), "row 3", "cycle", "whole number")
