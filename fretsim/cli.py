@@ -743,7 +743,10 @@ def fit(case_file: Path, measured_file: Path, fit_keys: tuple, overrides: tuple,
 
     if output is not None:
         _not_an_input(output, {"case file": case_file, "measured file": measured_file})
-    text = read_text(case_file, "case file")
+    try:
+        text = read_text(case_file, "case file")
+    except (OSError, ValueError) as exc:  # not a write: the boundary's OSError would say "cannot write", exit 5
+        raise Fail(f"{case_file}: {exc}") from None
     measured = read_measured(measured_file)
     click.echo(f"fitting {', '.join(fit_keys or DEFAULT_FIT)} to {measured.values.size} measured value(s) of "
                f"{measured_file}", err=True)

@@ -19,6 +19,7 @@ unstable for some coefficients a search may try).
 from __future__ import annotations
 
 import csv
+import io
 import math
 import re
 from dataclasses import dataclass, field
@@ -31,12 +32,14 @@ from fretsim.case import LIMITS_SCHEMA, SCHEMA, Case, CaseError, Key, parse_case
 from fretsim.limits import LIMIT_KEYS
 from fretsim.simulate import SimulationError
 from fretsim.units import UnitError, format_quantity, parse_quantity
+from fretsim.yamlread import read_text
 
 DEFAULT_FIT = ("materials.moving.wear_coefficient", "materials.stationary.wear_coefficient")
 PROFILES = {"wear_depth_moving": "moving", "wear_depth_stationary": "stationary"}
 FIT_TOLERANCE = 1e-3  # jumping.tolerance of the fit's runs, at most
 DIFF_STEP = 0.05  # the finite differences' step in ln(value)
 RANGE = 1000.0  # a value is sought within this factor of the case's
+MAX_ROWS = 10_000  # rows of measurements: an exported history of a long run has a few hundred
 _HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[\s*([^\]]*)\s*\])?\s*$")
 
 
@@ -100,13 +103,18 @@ def read_measured(path: str | Path) -> Measured:
 
 
 def _csv_rows(path: Path, source: str) -> list[list[str]]:
-    """The file's rows without comments: a header and at least one row of data."""
+    """The file's rows without comments: a header and at least one row of data.  Read as a case file is (a
+    regular file of at most MAX_BYTES, opened without blocking): a FIFO or a device would hang the fit."""
     try:
-        with open(path, newline="", encoding="utf-8") as fh:
-            rows = list(csv.reader(fh))
-    except (OSError, UnicodeDecodeError) as exc:
-        raise CaseError(source, [("", f"cannot read it: {exc}")], "measurements") from None
-    rows = [r for r in rows if r and not r[0].lstrip().startswith("#")]
+        text = read_text(path, "measurements file", typical="measurements are a few kB")
+    except (OSError, ValueError) as exc:
+        raise CaseError(source, [("", str(exc))], "measurements") from None
+    rows = [r for r in csv.reader(io.StringIO(text.removeprefix("\ufeff"), newline=""))
+            if r and not r[0].lstrip().startswith("#")]
+    if len(rows) - 1 > MAX_ROWS:
+        raise CaseError(source, [("", f"{len(rows) - 1} rows of data; a fit takes at most {MAX_ROWS:,} (every "
+                                      f"measured cycle is a recorded state of each of the fit's runs)")],
+                        "measurements")
     if len(rows) < 2:
         raise CaseError(source, [("", "expected a header like `cycle [cycles],max_wear_depth_stationary [um]` and "
                                       "at least one row")], "measurements")

@@ -48,8 +48,10 @@ def excerpt(value: Any, width: int = 40) -> str:
     return text if len(text) <= width else text[:width - 5] + "…" + text[-4:]
 
 
-def read_text(path: str | Path, what: str = "file", max_bytes: int = MAX_BYTES) -> str:
-    """The text of a regular file of at most ``max_bytes``; OSError/ValueError with a plain message otherwise."""
+def read_text(path: str | Path, what: str = "file", max_bytes: int = MAX_BYTES,
+              typical: str = "a case is a few kB") -> str:
+    """The text of a regular file of at most ``max_bytes``; OSError/ValueError with a plain message otherwise
+    (``typical`` says how large such a file usually is, for the message on an oversize one)."""
     path = Path(path)
     try:
         fd = os.open(path, os.O_RDONLY | getattr(os, "O_NONBLOCK", 0))
@@ -64,7 +66,7 @@ def read_text(path: str | Path, what: str = "file", max_bytes: int = MAX_BYTES) 
         if not stat.S_ISREG(st.st_mode):
             raise ValueError(f"expected a regular {what}, got a device, FIFO or socket")
         if st.st_size > max_bytes:
-            raise ValueError(f"the {what} is {st.st_size / 1e6:.1f} MB; a case is a few kB (limit {max_bytes / 1e6:g} MB)")
+            raise ValueError(f"the {what} is {st.st_size / 1e6:.1f} MB; {typical} (limit {max_bytes / 1e6:g} MB)")
         data = os.read(fd, max_bytes + 1)
     finally:
         os.close(fd)

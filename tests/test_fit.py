@@ -90,3 +90,44 @@ def test_a_measured_cycle_that_is_not_a_whole_number_above_0_is_refused_naming_i
     path.write_text(f"cycle [cycles],max_wear_depth_stationary [um]\n1000,0.1\n{cycle},1\n")
     r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(path)])
     refused(r, str(path), "row 3", "cycle", "whole number")
+
+
+# --- 3. a measured file is a small regular file --------------------------------------------------------------------
+
+def _fifo(tmp_path):
+    path = tmp_path / "fifo.csv"
+    os.mkfifo(path)
+    return path, "regular"
+
+
+def _zero(tmp_path):
+    return Path("/dev/zero"), "regular"
+
+
+def _huge(tmp_path):
+    path = tmp_path / "huge.csv"
+    with open(path, "wb") as fh:  # sparse: 50 MB on paper, nothing on disk
+        fh.write(b"cycle [cycles],max_wear_depth_stationary [um]\n")
+        fh.truncate(50_000_000)
+    return path, "50.0 MB"
+
+
+def _long(tmp_path):
+    path = tmp_path / "long.csv"
+    path.write_text("cycle [cycles],max_wear_depth_stationary [um]\n" + "".join(f"{n},0.5\n" for n in
+                                                                                range(1, 20_002)))
+    return path, "rows"
+
+
+@pytest.mark.parametrize("make", [_fifo, _zero, _huge, _long], ids=["fifo", "dev_zero", "50MB", "20000_rows"])
+def test_a_measured_file_that_is_not_a_small_regular_file_is_refused_at_once(tmp_path, make):
+    path, reason = make(tmp_path)
+    r = fit_cli(CASE, "--measured", path, timeout=30)
+    refused(r, str(path), reason)
+
+
+@pytest.mark.parametrize("make", [_fifo, lambda tmp: (tmp / "none.yaml", "does not exist")], ids=["fifo", "missing"])
+def test_a_case_file_that_cannot_be_read_is_bad_input_to_fit(truth, tmp_path, make):
+    path, reason = make(tmp_path)
+    r = fit_cli(path, "--measured", truth / "measured.csv", timeout=30)
+    refused(r, str(path), reason)
