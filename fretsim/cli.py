@@ -748,6 +748,8 @@ def fit(case_file: Path, measured_file: Path, fit_keys: tuple, overrides: tuple,
     except (OSError, ValueError) as exc:  # not a write: the boundary's OSError would say "cannot write", exit 5
         raise Fail(f"{case_file}: {exc}") from None
     measured = read_measured(measured_file)
+    for note in measured.notes:
+        click.echo(f"note: {note}", err=True)
     click.echo(f"fitting {', '.join(fit_keys or DEFAULT_FIT)} to {measured.values.size} measured value(s) of "
                f"{measured_file}", err=True)
     try:

@@ -51,6 +51,7 @@ class Measured:
     values: np.ndarray  # per datum, internal units
     x: np.ndarray  # per datum: the profile's x (mm), NaN for a scalar
     units: dict = field(default_factory=dict)  # column → unit as written
+    notes: list = field(default_factory=list)  # what was read but not fitted, for the user to see
 
 
 def _spec(key: str) -> Key:
@@ -83,23 +84,30 @@ def read_measured(path: str | Path) -> Measured:
     path = Path(path)
     source = str(path)
     rows = _csv_rows(path, source)
-    problems = []
-    columns = _columns(rows[0], problems)
+    problems, notes = [], []
+    columns, ignored = _columns(rows[0], problems)
     names = [c[0] for c in columns]
+    known = ", ".join([*LIMIT_KEYS, *PROFILES])
     if "cycle" not in names:
         problems.append(("header", "no `cycle` column"))
+    if not any(n in LIMIT_KEYS or n in PROFILES for n in names):
+        problems.append(("header", f"no column fretsim can fit; expected cycle and any of {known}"))
+    if problems:  # refused anyway: a column it did not know may be the misspelt one it needed
+        problems += [(f"column {n}", "not a quantity fretsim reports") for n in ignored]
+    elif ignored:  # an exported history holds pressures, times, counts: the wear columns are what a fit uses
+        notes.append(f"{source}: not fitted, not wear quantities fretsim compares with a run: {', '.join(ignored)}")
     profile = "x" in names
     if profile and not any(n in PROFILES for n in names):
         problems.append(("header", f"an x column needs a profile column ({', '.join(PROFILES)})"))
     if problems:
         raise CaseError(source, problems, "measurements")
-    cyc, keys, vals, xs = _data(rows, columns, profile, problems)
+    cyc, keys, vals, xs = _data(rows, columns, profile, problems, notes)
     if problems:
         raise CaseError(source, problems[:30], "measurements")
     if not vals:
         raise CaseError(source, [("", "no measured values")], "measurements")
     return Measured(source, np.array(cyc), keys, np.array(vals, float), np.array(xs, float),
-                    {c[0]: c[2] for c in columns if c[0]})
+                    {c[0]: c[2] for c in columns if c[0]}, notes)
 
 
 def _csv_rows(path: Path, source: str) -> list[list[str]]:
@@ -121,9 +129,10 @@ def _csv_rows(path: Path, source: str) -> list[list[str]]:
     return rows
 
 
-def _columns(header: list[str], problems: list) -> list[tuple]:
-    """(name, kind, unit) of each header cell; (None, None, None) for one that cannot be read (a problem noted)."""
-    columns = []
+def _columns(header: list[str], problems: list) -> tuple[list[tuple], list[str]]:
+    """(name, kind, unit) of each header cell, (None, None, None) for one that cannot be read (a problem noted) or
+    is not a quantity fretsim reports; and the names of those (ignored, unless no fittable column remains)."""
+    columns, ignored = [], []
     for j, text in enumerate(header):
         m = _HEADER.match(text)
         if not m:
@@ -141,16 +150,16 @@ def _columns(header: list[str], problems: list) -> list[tuple]:
         elif name in PROFILES:
             columns.append((name, "length", unit))
         else:
-            known = ", ".join([*LIMIT_KEYS, *PROFILES])
-            problems.append((f"column {name}", f"not a quantity fretsim reports; expected cycle and any of {known}"))
+            ignored.append(name)
             columns.append((None, None, None))
             continue
         if name != "cycle" and columns[-1][1] != "fraction" and not unit:
             problems.append((f"column {name}", f"no unit; write e.g. `{name} [um]`"))
-    return columns
+    return columns, ignored
 
 
-def _data(rows: list[list[str]], columns: list[tuple], profile: bool, problems: list) -> tuple[list, ...]:
+def _data(rows: list[list[str]], columns: list[tuple], profile: bool, problems: list,
+          notes: list) -> tuple[list, ...]:
     """(cycle, key, value, x) of every measured cell below the header, in file order; problems noted per row."""
     names = [c[0] for c in columns]
     cyc, keys, vals, xs = [], [], [], []
@@ -160,6 +169,9 @@ def _data(rows: list[list[str]], columns: list[tuple], profile: bool, problems: 
             n = float(cells["cycle"])
         except (KeyError, ValueError):
             problems.append((f"row {i}", f"cycle {cells.get('cycle')!r} is not a number"))
+            continue
+        if n == 0 and _unworn(row, columns):  # an exported history starts at the unworn state: nothing to fit
+            notes.append(f"row {i}: cycle 0, the unworn start, is not fitted (a relative residual needs wear)")
             continue
         if not (math.isfinite(n) and n > 0 and n == int(n)):  # int() of inf raises, of nan too
             problems.append((f"row {i}", f"cycle {cells['cycle']!r}: expected a whole number of cycles above 0"))
@@ -188,6 +200,16 @@ def _data(rows: list[list[str]], columns: list[tuple], profile: bool, problems: 
         if profile and not math.isfinite(x):
             problems.append((f"row {i}", "no x for the profile's point"))
     return cyc, keys, vals, xs
+
+
+def _unworn(row: list[str], columns: list[tuple]) -> bool:
+    """Every fittable cell of the row empty or zero (a row at cycle 0 with wear in it is an error, not a start)."""
+    def zero(text: str) -> bool:
+        try:
+            return float(text) == 0
+        except ValueError:
+            return not text.strip()
+    return all(zero(text) for (name, _, _), text in zip(columns, row) if name in LIMIT_KEYS or name in PROFILES)
 
 
 def _cell(text: str, kind: str, unit: str) -> float:

@@ -131,3 +131,23 @@ def test_a_case_file_that_cannot_be_read_is_bad_input_to_fit(truth, tmp_path, ma
     path, reason = make(tmp_path)
     r = fit_cli(path, "--measured", truth / "measured.csv", timeout=30)
     refused(r, str(path), reason)
+
+
+# --- 6. the history `fretsim export` writes -------------------------------------------------------------------------
+
+def test_fit_reads_the_history_export_writes_and_names_the_columns_it_ignores(truth):
+    r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(truth / "export" / "history.csv"),
+                                  "--set", TWO_D, "--set", f"materials.moving.wear_coefficient={K_MOVING} 1/MPa",
+                                  "--fit", "materials.stationary.wear_coefficient"])
+    assert r.exit_code == 0, r.output
+    note = next(line for line in r.output.splitlines() if line.startswith("note:") and "max_pressure" in line)
+    assert "max_wear_depth_total" in note and "wear_volume_stationary" not in note
+    value = float(re.search(r"materials.stationary.wear_coefficient = (\S+)", r.output).group(1))
+    assert value == pytest.approx(K_STATIONARY, rel=0.03)
+
+
+def test_a_file_whose_every_column_is_one_fit_cannot_use_is_refused_naming_them(tmp_path):
+    path = tmp_path / "m.csv"
+    path.write_text("cycle [cycles],max_pressure [MPa],solver_iterations\n100,300,4\n")
+    r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(path)])
+    refused(r, "max_pressure", "solver_iterations", "no column")
