@@ -754,7 +754,8 @@ def fit(case_file: Path, measured_file: Path, fit_keys: tuple, overrides: tuple,
                f"{measured_file}", err=True)
     try:
         res = fit_case(text, str(case_file), measured, fit_keys or DEFAULT_FIT, overrides,
-                       progress=lambda n: click.echo(f"\r  {n} runs", nl=False, err=True))
+                       progress=lambda n: click.echo(f"\r  {n} runs", nl=False, err=True),
+                       note=lambda text: click.echo(f"note: {text}", err=True))
     except RuntimeError as exc:
         raise Fail(f"the fit stopped: {exc}", 3) from None
     click.echo("", err=True)

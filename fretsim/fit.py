@@ -35,6 +35,7 @@ from fretsim.units import UnitError, format_quantity, parse_quantity
 from fretsim.yamlread import read_text
 
 DEFAULT_FIT = ("materials.moving.wear_coefficient", "materials.stationary.wear_coefficient")
+WEAR_KINDS = ("wear_coefficient", "energy_wear_coefficient")  # the values whose top of the search wears most
 PROFILES = {"wear_depth_moving": "moving", "wear_depth_stationary": "stationary"}
 FIT_TOLERANCE = 1e-3  # jumping.tolerance of the fit's runs, at most
 DIFF_STEP = 0.05  # the finite differences' step in ln(value)
@@ -311,7 +312,7 @@ def _start(case: Case, key: str, spec: Key) -> float:
 
 
 def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overrides=(),
-        progress: Optional[Callable[[int], None]] = None) -> FitResult:
+        progress: Optional[Callable[[int], None]] = None, note: Optional[Callable[[str], None]] = None) -> FitResult:
     """Fit ``keys`` of the case to the measurements.
 
     Parameters
@@ -321,6 +322,7 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
     keys : dotted case keys of the values to fit, each set in the case (its starting value) and above 0.
     overrides : ``key=value`` overrides applied to every run.
     progress : called with the number of runs so far after each run.
+    note : called, before the first run, with what the user should know of the fit's grid (a larger one).
 
     Returns
     -------
@@ -338,7 +340,11 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
     if (start <= 0).any():
         raise CaseError(source, [(k, "a fitted value must start above 0") for k, v in zip(keys, start) if v <= 0],
                         "fit")
-    fixed = _fixed_choices(case_text, source, base, case0)
+    _check_columns(case0, measured)
+    tops = [f"{k}={_written(v * RANGE, s.kind)}" for k, v, s in zip(keys, start, specs) if s.kind in WEAR_KINDS]
+    fixed, grown = _fixed_choices(case_text, source, base, case0, tops)
+    if grown and note is not None:
+        note(grown)
     runs = [0]
     cache: dict = {}
 
@@ -372,18 +378,58 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
                      dof, message or sol.message, tuple(s.kind for s in specs))
 
 
-def _fixed_choices(case_text: str, source: str, base: list, case0: Case) -> list[str]:
-    """The grid and the automatic choices, fixed once at the starting values: every run compares like with like."""
+def _check_columns(case: Case, measured: Measured) -> None:
+    """Refuse a measured quantity the case's geometry does not have (a wall loss is a tube's)."""
+    if "wall_loss" in measured.keys and getattr(case.geometry, "wall", None) is None:
+        raise CaseError(measured.source, [("column wall_loss", f"a wall loss is a tube's deepest wear over its wall "
+                                                               f"(tube_on_flat); a {case.geometry.kind} has no wall: "
+                                                               f"measure max_wear_depth_moving")], "measurements")
+
+
+def _fixed_choices(case_text: str, source: str, base: list, case0: Case, tops: list) -> tuple[list[str], str]:
+    """The grid and the automatic choices, fixed once at the starting values: every run compares like with like.
+    An automatic grid's domain holds the wear of ``tops`` (the wear coefficients at the top of the search); the
+    second item says so when that grid is larger than the starting values' ("" otherwise)."""
     from fretsim.plan import prepare
     _, filled, _ = prepare(parse_case(case_text, source=source, overrides=base))
     corrections = "none" if not filled.corrections or filled.corrections == "none" else list(filled.corrections)
-    return [f"model.dimension={filled.dimension}", f"grid.domain=[{', '.join(f'{d!r} mm' for d in filled.domain)}]",
-            f"grid.elements=[{', '.join(map(str, filled.elements))}]",
-            f"model.corrections={corrections}",
-            f"model.slip={filled.slip}",
-            # the paper's mid-stroke gap is unstable where the moving body wears too little, which a search over
-            # the coefficients can reach: the stroke-averaged gap is stable for any (unless the case names one)
-            f"model.gap={case0.gap_model if case0.gap_model != 'auto' else 'stroke_average'}"]
+    model = [f"model.dimension={filled.dimension}", f"model.corrections={corrections}", f"model.slip={filled.slip}",
+             # the paper's mid-stroke gap is unstable where the moving body wears too little, which a search over
+             # the coefficients can reach: the stroke-averaged gap is stable for any (unless the case names one)
+             f"model.gap={case0.gap_model if case0.gap_model != 'auto' else 'stroke_average'}"]
+    domain, elements = filled.domain, filled.elements
+    if case0.domain is None and case0.elements is None:  # a grid the case gives stays the case's
+        domain, elements = _holding(parse_case(case_text, source=source, overrides=[*base, *model, *tops]), filled)
+    grown = "" if tuple(elements) == tuple(filled.elements) else (
+        f"the fit's grid holds the wear of {', '.join(t.split('=')[0] for t in tops)} at {RANGE:g}× the starting "
+        f"value (the top of the search): {' × '.join(map(str, elements))} elements of the starting grid's size, "
+        f"where the starting values need {' × '.join(map(str, filled.elements))}, so a 3D run costs more; give "
+        f"grid.domain and grid.elements to choose the grid")
+    return [*model, f"grid.domain=[{', '.join(f'{d!r} mm' for d in domain)}]",
+            f"grid.elements=[{', '.join(map(str, elements))}]"], grown
+
+
+def _holding(top: Case, filled: Case) -> tuple[tuple, tuple]:
+    """The starting grid's elements over a domain that holds the scar of ``top``, the most wear the search may
+    try: a search from a low first guess goes well beyond it, and a run whose contact reaches the grid's edge
+    stops the fit; the element stays the one planned at the starting values, so the fit is as resolved."""
+    from fretsim.plan.choices import Plan
+    from fretsim.plan.inputs import contact
+    from fretsim.sizing import auto_grid
+    from fretsim.wear import GAP_REACH
+    c, loading = contact(top, Plan()), top.loading
+    k = c.k_moving + c.k_stationary
+    sizing = auto_grid(top.geometry, len(filled.elements) == 1, loading.lightest_load, loading.peak_stroke,
+                       loading.cycles, k, c.e_star, strokes=GAP_REACH[top.gap_model],
+                       volume=k * loading.worn_work(loading.cycles))
+    steps = [d / n for d, n in zip(filled.domain, filled.elements)]
+    elements = tuple(_odd(max(d, wide) / step) for d, wide, step in zip(filled.domain, sizing.domain, steps))
+    return tuple(n * step for n, step in zip(elements, steps)), elements
+
+
+def _odd(n: float) -> int:
+    n = max(int(math.ceil(n - 1e-9)), 1)  # the centre line on an element's centre, as the planner's grids
+    return n if n % 2 else n + 1
 
 
 def _intervals(sol, r: np.ndarray, p: int) -> tuple[np.ndarray, np.ndarray, int, str]:

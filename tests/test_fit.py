@@ -133,6 +133,37 @@ def test_a_case_file_that_cannot_be_read_is_bad_input_to_fit(truth, tmp_path, ma
     refused(r, str(path), reason)
 
 
+# --- 4. the fit's runs hold the contact within its bounds; columns the geometry has not are refused -----------------
+
+def test_a_fit_started_three_times_below_the_truth_holds_the_contact_and_finds_it(truth):
+    """A normal first guess, both coefficients 3× low: the searches beyond them once ran off the grid (exit 3)."""
+    low = [TWO_D, f"materials.moving.wear_coefficient={K_MOVING / 3} 1/MPa",
+           f"materials.stationary.wear_coefficient={K_STATIONARY / 3} 1/MPa"]
+    res = fit(CASE.read_text(), str(CASE), read_measured(truth / "measured.csv"), overrides=low)
+    assert res.converged, res.message
+    for true, lo, hi in zip((K_MOVING, K_STATIONARY), res.low, res.high):
+        assert lo <= true <= hi, (true, lo, hi)
+
+
+def test_a_fit_to_one_measured_depth_holds_the_contact(tmp_path, truth):
+    """One datum for both coefficients, both started 3× low: nothing pins the pair, and the search wanders to
+    wear the grid planned at the starting values did not hold (a stop at the x edge, exit 3)."""
+    last = (truth / "measured.csv").read_text().splitlines()[-1].split(",")
+    path = tmp_path / "one.csv"
+    path.write_text(f"cycle [cycles],max_wear_depth_stationary [um]\n{last[0]},{last[2]}\n")
+    low = [TWO_D, f"materials.moving.wear_coefficient={K_MOVING / 3} 1/MPa",
+           f"materials.stationary.wear_coefficient={K_STATIONARY / 3} 1/MPa"]
+    res = fit(CASE.read_text(), str(CASE), read_measured(path), overrides=low)
+    assert res.dof == -1 and abs(res.residuals[0]) < 1e-3
+
+
+def test_a_wall_loss_column_on_a_cylinder_is_refused_by_name(tmp_path):
+    path = tmp_path / "m.csv"
+    path.write_text("cycle [cycles],wall_loss [%]\n18000,20\n")
+    r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(path), "--set", TWO_D])
+    refused(r, "wall_loss", "cylinder_on_flat", "wall")
+
+
 # --- 6. the history `fretsim export` writes -------------------------------------------------------------------------
 
 def test_fit_reads_the_history_export_writes_and_names_the_columns_it_ignores(truth):
