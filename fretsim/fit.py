@@ -288,6 +288,7 @@ class FitResult:
     dof: int
     message: str
     kinds: tuple = ()
+    given: tuple = ()  # the overrides every run had (--set): the fitted case is the case with them
 
     @property
     def converged(self) -> bool:
@@ -375,7 +376,7 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
                    f"cannot reproduce the data with values in that range (see the residuals); the values are "
                    f"not a fit" + (f"; {message}" if message else ""))
     return FitResult(keys, start, np.exp(sol.x), low, high, r, cache[tuple(np.round(sol.x, 12))], measured, runs[0],
-                     dof, message or sol.message, tuple(s.kind for s in specs))
+                     dof, message or sol.message, tuple(s.kind for s in specs), tuple(overrides))
 
 
 def _check_columns(case: Case, measured: Measured) -> None:
@@ -459,15 +460,18 @@ def _intervals(sol, r: np.ndarray, p: int) -> tuple[np.ndarray, np.ndarray, int,
 
 
 def fitted_case_text(case_text: str, result: FitResult) -> str:
-    """The case file's mapping with the fitted values set (comments are not kept)."""
+    """The case file's mapping with the overrides the fit ran with and the fitted values set (comments are not
+    kept): the case the fitted values are the fit of, which reruns to the fitted numbers."""
     import yaml
 
     from fretsim.case import _apply_override
     from fretsim.yamlread import loads
     raw = loads(case_text)
     problems: list = []
-    for item in result.overrides():
+    for item in [*result.given, *result.overrides()]:
         _apply_override(raw, item, problems)
     header = "# fitted by fretsim fit to " + Path(result.measured.source).name + ": " + ", ".join(
         f"{k} = {_written(v, kind)}" for k, v, kind in zip(result.keys, result.values, result.kinds)) + "\n"
+    if result.given:
+        header += "# with the overrides it ran with: " + ", ".join(result.given) + "\n"
     return header + yaml.safe_dump(raw, sort_keys=False, allow_unicode=True)

@@ -164,6 +164,25 @@ def test_a_wall_loss_column_on_a_cylinder_is_refused_by_name(tmp_path):
     refused(r, "wall_loss", "cylinder_on_flat", "wall")
 
 
+# --- 5. the fitted case is the case the fit ran ---------------------------------------------------------------------
+
+def test_the_fitted_case_keeps_the_set_overrides_and_reruns_to_the_fitted_depth(truth, tmp_path):
+    out = tmp_path / "fitted.yaml"
+    r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(truth / "measured.csv"), "--set", TWO_D,
+                                  "--set", f"materials.moving.wear_coefficient={K_MOVING} 1/MPa",
+                                  "--fit", "materials.stationary.wear_coefficient", "-o", str(out)])
+    assert r.exit_code == 0, r.output
+    fitted = load_case(out)
+    assert fitted.dimension == "2d"
+    assert fitted.moving.wear_coefficient == K_MOVING
+    printed = float(re.search(r"materials.stationary.wear_coefficient = (\S+)", r.output).group(1))
+    assert fitted.stationary.wear_coefficient == pytest.approx(printed, rel=1e-3)
+    model = float(re.search(r"18,000  max_wear_depth_stationary: measured \S+ um, model (\S+) um", r.output)
+                  .group(1))
+    again = run(fitted, tmp_path / "again.h5")
+    assert again.summary["max_wear_depth_stationary_um"] == pytest.approx(model, rel=0.01)
+
+
 # --- 6. the history `fretsim export` writes -------------------------------------------------------------------------
 
 def test_fit_reads_the_history_export_writes_and_names_the_columns_it_ignores(truth):
