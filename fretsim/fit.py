@@ -53,6 +53,7 @@ class Measured:
     x: np.ndarray  # per datum: the profile's x (mm), NaN for a scalar
     units: dict = field(default_factory=dict)  # column → unit as written
     notes: list = field(default_factory=list)  # what was read but not fitted, for the user to see
+    rows: list = field(default_factory=list)  # per datum: its row in the file's data, as messages number them
 
 
 def _spec(key: str) -> Key:
@@ -102,13 +103,13 @@ def read_measured(path: str | Path) -> Measured:
         problems.append(("header", f"an x column needs a profile column ({', '.join(PROFILES)})"))
     if problems:
         raise CaseError(source, problems, "measurements")
-    cyc, keys, vals, xs = _data(rows, columns, profile, problems, notes)
+    cyc, keys, vals, xs, where = _data(rows, columns, profile, problems, notes)
     if problems:
         raise CaseError(source, problems[:30], "measurements")
     if not vals:
         raise CaseError(source, [("", "no measured values")], "measurements")
     return Measured(source, np.array(cyc), keys, np.array(vals, float), np.array(xs, float),
-                    {c[0]: c[2] for c in columns if c[0]}, notes)
+                    {c[0]: c[2] for c in columns if c[0]}, notes, where)
 
 
 def _csv_rows(path: Path, source: str) -> list[list[str]]:
@@ -161,9 +162,10 @@ def _columns(header: list[str], problems: list) -> tuple[list[tuple], list[str]]
 
 def _data(rows: list[list[str]], columns: list[tuple], profile: bool, problems: list,
           notes: list) -> tuple[list, ...]:
-    """(cycle, key, value, x) of every measured cell below the header, in file order; problems noted per row."""
+    """(cycle, key, value, x, row) of every measured cell below the header, in file order; problems noted per
+    row."""
     names = [c[0] for c in columns]
-    cyc, keys, vals, xs = [], [], [], []
+    cyc, keys, vals, xs, where = [], [], [], [], []
     for i, row in enumerate(rows[1:], start=2):
         cells = dict(zip(names, row))
         try:
@@ -198,9 +200,10 @@ def _data(rows: list[list[str]], columns: list[tuple], profile: bool, problems: 
             keys.append(name)
             vals.append(value)
             xs.append(x)
+            where.append(i)
         if profile and not math.isfinite(x):
             problems.append((f"row {i}", "no x for the profile's point"))
-    return cyc, keys, vals, xs
+    return cyc, keys, vals, xs, where
 
 
 def _unworn(row: list[str], columns: list[tuple]) -> bool:
@@ -343,6 +346,8 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
                         "fit")
     _check_columns(case0, measured)
     tops = [f"{k}={_written(v * RANGE, s.kind)}" for k, v, s in zip(keys, start, specs) if s.kind in WEAR_KINDS]
+    if len(tops) == len(keys):  # a fitted load or stroke would wear beyond what the coefficients bound
+        _check_scale(parse_case(case_text, source=source, overrides=[*base, *tops]), measured)
     fixed, grown = _fixed_choices(case_text, source, base, case0, tops)
     if grown and note is not None:
         note(grown)
@@ -385,6 +390,41 @@ def _check_columns(case: Case, measured: Measured) -> None:
         raise CaseError(measured.source, [("column wall_loss", f"a wall loss is a tube's deepest wear over its wall "
                                                                f"(tube_on_flat); a {case.geometry.kind} has no wall: "
                                                                f"measure max_wear_depth_moving")], "measurements")
+
+
+def _check_scale(top: Case, measured: Measured) -> None:
+    """Refuse a measured depth, width or volume that no run of the search can come near, a unit slip (mm for µm
+    is a factor of 1000): ``top`` is the case at the top of the search.  Its worn volume (Archard's, both bodies)
+    at each measured cycle, held in a scar of the geometry's shape (its own sizing estimate), bounds the depth
+    from above (2V over the scar's area: 1.7× the cylinder's segment depth, the cap's own), and the width (the
+    scar and two strokes, as the grid is sized); no width is a tenth of the unworn contact's half-width a."""
+    from fretsim.plan.choices import Plan
+    from fretsim.plan.inputs import contact
+    from fretsim.sizing import SCAR_MARGIN
+    c, loading, g = contact(top, Plan()), top.loading, top.geometry
+    k = c.k_moving + c.k_stationary
+    a_min = g.hertz(loading.lightest_load, c.e_star).half_width_x
+    a_max = g.hertz(loading.peak_load, c.e_star).half_width_x
+    problems: dict = {}
+    for i, (n, key, v) in enumerate(zip(measured.cycles, measured.keys, measured.values)):
+        volume = k * loading.worn_work(int(n))
+        wx, wy = g.scar_half_widths(volume)
+        kind = "volume" if key.startswith("wear_volume") else "width" if key.startswith("scar_width") else (
+            "depth" if key in PROFILES or LIMITS_SCHEMA[key].kind == "length" else None)
+        bound = {"volume": volume, "depth": 2 * volume / (math.pi * wx * wy),
+                 "width": 2 * (SCAR_MARGIN * max(wx, a_max) + 2 * loading.peak_stroke)}.get(kind)
+        if key in problems or bound is None or not (v > bound or (kind == "width" and v < a_min / 10)):
+            continue
+        small = v <= bound
+        where = (f"less than a tenth of the unworn contact's half-width a = {shown(a_min, key, measured)}" if small
+                 else f"more than any run of the fit can reach by cycle {n:,} (at most {shown(bound, key, measured)}"
+                      f", with the wear coefficients {RANGE:g}× their starting values)")
+        problems[key] = (f"column {key} [{measured.units.get(key)}]",
+                         f"{shown(v, key, measured)} (row {measured.rows[i]}) is {where}: is the column's unit "
+                         f"right? (" + ("a width in mm written as um is 1000× too narrow)" if small else
+                                        "a value in um written as mm is 1000× too large)"))
+    if problems:
+        raise CaseError(measured.source, list(problems.values()), "measurements")
 
 
 def _fixed_choices(case_text: str, source: str, base: list, case0: Case, tops: list) -> tuple[list[str], str]:

@@ -201,3 +201,18 @@ def test_a_file_whose_every_column_is_one_fit_cannot_use_is_refused_naming_them(
     path.write_text("cycle [cycles],max_pressure [MPa],solver_iterations\n100,300,4\n")
     r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(path)])
     refused(r, "max_pressure", "solver_iterations", "no column")
+
+
+# --- 7. a unit slip ------------------------------------------------------------------------------------------------
+
+@pytest.mark.parametrize("header, row, column", [
+    ("cycle [cycles],max_wear_depth_stationary [mm]", "18000,1.28", "max_wear_depth_stationary [mm]"),
+    ("cycle [cycles],scar_width_stationary [um]", "18000,0.51", "scar_width_stationary [um]"),
+    ("cycle [cycles],scar_width_stationary [um]", "18000,510000", "scar_width_stationary [um]"),
+])
+def test_measured_values_a_unit_slip_away_from_the_case_are_refused_naming_the_column_and_unit(tmp_path, header,
+                                                                                             row, column):
+    path = tmp_path / "m.csv"
+    path.write_text(f"{header}\n{row}\n")
+    r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(path), "--set", TWO_D])
+    refused(r, str(path), column, "unit")
