@@ -14,7 +14,9 @@ Student's t at 95 %; with as many values as data there are none, and the result 
 case's stepping at a tolerance of at most 1e-3, so that the finite differences (5 % in each value) are not
 stepping noise, on one grid and with one model throughout (those the case chooses at its starting values; the
 flat's wear through the stroke-averaged gap unless the case names one, since the paper's mid-stroke gap is
-unstable for some coefficients a search may try).
+unstable for some coefficients a search may try).  An automatic grid's domain holds the scar of the wear
+coefficients at the top of the search, so that no run of it reaches the grid's edge; measured values that no run
+of the search can come near (a unit slip) are refused before any run.
 """
 from __future__ import annotations
 
