@@ -35,7 +35,7 @@ def _check(args: list) -> str:
     return verdict
 
 
-def _friction(rng):
+def _friction(tmp_path, rng):
     sets = hostile.friction_example(rng)
     _check([CASE, *[a for s in sets for a in ("--set", s)]])
 
@@ -45,7 +45,7 @@ def _history(tmp_path, rng):
     _check([str(tmp_path / "h.yaml")])
 
 
-def _limits(rng):
+def _limits(tmp_path, rng):
     sets = hostile.limits_example(rng)
     _check([CASE, *[a for s in sets for a in ("--set", s)]])
 
@@ -68,66 +68,23 @@ def _measured(tmp_path, rng):
         pass
 
 
-@settings(max_examples=15, **FAST)
-@given(RNG)
-def test_fuzzed_friction_keys(rng):
-    _friction(rng)
+def _fuzzed(surface, examples: int):
+    """A test of ``examples`` examples of one surface (drawn from hypothesis' seeded randoms)."""
+    @settings(max_examples=examples, **FAST)
+    @given(RNG)
+    def test(tmp_path, rng):
+        surface(tmp_path, rng)
+    return test
 
 
-@settings(max_examples=15, **FAST)
-@given(RNG)
-def test_fuzzed_load_histories(tmp_path, rng):
-    _history(tmp_path, rng)
-
-
-@settings(max_examples=10, **FAST)
-@given(RNG)
-def test_fuzzed_wear_limits(rng):
-    _limits(rng)
-
-
-@settings(max_examples=40, **FAST)
-@given(RNG)
-def test_fuzzed_sampled_sweeps(tmp_path, rng):
-    _sampled(tmp_path, rng)
-
-
-@settings(max_examples=60, **FAST)
-@given(RNG)
-def test_fuzzed_measured_files(tmp_path, rng):
-    _measured(tmp_path, rng)
-
-
-@pytest.mark.slow
-@settings(max_examples=1000, **FAST)
-@given(RNG)
-def test_fuzzed_friction_keys_1000(rng):
-    _friction(rng)
-
-
-@pytest.mark.slow
-@settings(max_examples=1000, **FAST)
-@given(RNG)
-def test_fuzzed_load_histories_1000(tmp_path, rng):
-    _history(tmp_path, rng)
-
-
-@pytest.mark.slow
-@settings(max_examples=1000, **FAST)
-@given(RNG)
-def test_fuzzed_wear_limits_1000(rng):
-    _limits(rng)
-
-
-@pytest.mark.slow
-@settings(max_examples=1000, **FAST)
-@given(RNG)
-def test_fuzzed_sampled_sweeps_1000(tmp_path, rng):
-    _sampled(tmp_path, rng)
-
-
-@pytest.mark.slow
-@settings(max_examples=1000, **FAST)
-@given(RNG)
-def test_fuzzed_measured_files_1000(tmp_path, rng):
-    _measured(tmp_path, rng)
+# a sample by default (a few seconds in all), 1 000 of each in the slow suite
+test_fuzzed_friction_keys = _fuzzed(_friction, 15)
+test_fuzzed_load_histories = _fuzzed(_history, 15)
+test_fuzzed_wear_limits = _fuzzed(_limits, 10)
+test_fuzzed_sampled_sweeps = _fuzzed(_sampled, 40)
+test_fuzzed_measured_files = _fuzzed(_measured, 60)
+test_fuzzed_friction_keys_1000 = pytest.mark.slow(_fuzzed(_friction, 1000))
+test_fuzzed_load_histories_1000 = pytest.mark.slow(_fuzzed(_history, 1000))
+test_fuzzed_wear_limits_1000 = pytest.mark.slow(_fuzzed(_limits, 1000))
+test_fuzzed_sampled_sweeps_1000 = pytest.mark.slow(_fuzzed(_sampled, 1000))
+test_fuzzed_measured_files_1000 = pytest.mark.slow(_fuzzed(_measured, 1000))
