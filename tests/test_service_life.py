@@ -489,3 +489,18 @@ def test_check_counts_the_block_starts_of_a_history_of_short_blocks():
         estimate = estimate_solves(prepare(history)[0])
         taken = run(history).summary["contact_solves"]
         assert 0.7 * taken <= estimate <= 1.3 * taken, (blocks, estimate, taken)
+
+
+def test_a_history_with_friction_in_some_blocks_only_is_refused_naming_the_first_block_without(tmp_path):
+    """Found by the fuzzing of issue 31: a friction coefficient on the second block and none on the first chose
+    Coulomb friction for the history and then multiplied the first block's missing μ (TypeError in `check`)."""
+    for loading in ("loading:\n  blocks:\n    - {normal_load: 100 N, stroke: 10 um, cycles: 1}\n"
+                    "    - {normal_load: 100 N, stroke: 25 um, cycles: 1, friction_coefficient: 0.9}\n",
+                    "loading:\n  cycles: 10\n  spectrum:\n    - {normal_load: 185 N, stroke: 25 um, fraction: 0.5, "
+                    "friction_coefficient: 0.5}\n    - {normal_load: 100 N, stroke: 25 um, fraction: 0.5}\n"):
+        with pytest.raises(CaseError) as info:
+            case(loading)
+        assert "friction_coefficient" in str(info.value) and "[" in str(info.value), str(info.value)
+    # given once for the loading, every block has it: accepted
+    case("loading:\n  friction_coefficient: 0.9\n  blocks:\n    - {normal_load: 100 N, stroke: 10 um, cycles: 1}\n"
+         "    - {normal_load: 100 N, stroke: 25 um, cycles: 1, friction_coefficient: 0.5}\n")
