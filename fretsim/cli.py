@@ -746,6 +746,7 @@ def fit(case_file: Path, measured_file: Path, fit_keys: tuple, overrides: tuple,
     if output is not None:
         _not_an_input(output, {"case file": case_file, "measured file": measured_file})
     try:
+        _not_results(Path(case_file))  # a results file where the case goes: say what it is
         text = read_text(case_file, "case file")
     except (OSError, ValueError) as exc:  # not a write: the boundary's OSError would say "cannot write", exit 5
         raise Fail(f"{case_file}: {exc}") from None

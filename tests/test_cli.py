@@ -293,11 +293,14 @@ def _interrupted(path: Path, at_cycle: int = 0) -> Path:
     return path
 
 
-@pytest.mark.parametrize("command", ["run", "check"])
+@pytest.mark.parametrize("command", ["run", "check", "fit"])
 def test_a_results_file_given_as_a_case_is_named_for_what_it_is_with_the_commands_that_read_it(tmp_path, command):
     """It was 'the case file is not UTF-8 text (byte 0)', or for a large one 'the case file is 7.5 MB'."""
     results = _interrupted(tmp_path / "r.h5")
-    r = CliRunner().invoke(main, [command, str(results)])
+    measured = tmp_path / "m.csv"
+    measured.write_text("cycle [cycles],max_wear_depth_stationary [um]\n18000,3.0\n")
+    extra = ["--measured", str(measured)] if command == "fit" else []
+    r = CliRunner().invoke(main, [command, str(results), *extra])
     assert r.exit_code == 2 and "Traceback" not in r.output, r.output
     assert f"{results} is a results file (HDF5, status 'interrupted')" in r.output, r.output
     assert f"fretsim run --resume {results}" in r.output and f"fretsim summary {results}" in r.output, r.output
