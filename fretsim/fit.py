@@ -14,9 +14,9 @@ Student's t at 95 %; with as many values as data there are none, and the result 
 case's stepping at a tolerance of at most 1e-3, so that the finite differences (5 % in each value) are not
 stepping noise, on one grid and with one model throughout (those the case chooses at its starting values; the
 flat's wear through the stroke-averaged gap unless the case names one, since the paper's mid-stroke gap is
-unstable for some coefficients a search may try).  An automatic grid's domain holds the scar of the wear
-coefficients at the top of the search, so that no run of it reaches the grid's edge; measured values that no run
-of the search can come near (a unit slip) are refused before any run.
+unstable for some coefficients a search may try).  An automatic grid is widened (same elements, a wider domain)
+and the search started again from the trial whose scar reached its edge; measured values that no run of the search
+can come near (a unit slip) are refused before any run.
 """
 from __future__ import annotations
 
@@ -34,6 +34,7 @@ from fretsim.case import LIMITS_SCHEMA, SCHEMA, Case, CaseError, Key, parse_case
 from fretsim.limits import LIMIT_KEYS
 from fretsim.simulate import SimulationError
 from fretsim.units import UnitError, format_quantity, parse_quantity
+from fretsim.sizing import _odd
 from fretsim.yamlread import read_text
 
 DEFAULT_FIT = ("materials.moving.wear_coefficient", "materials.stationary.wear_coefficient")
@@ -42,6 +43,17 @@ PROFILES = {"wear_depth_moving": "moving", "wear_depth_stationary": "stationary"
 FIT_TOLERANCE = 1e-3  # jumping.tolerance of the fit's runs, at most
 DIFF_STEP = 0.05  # the finite differences' step in ln(value)
 RANGE = 1000.0  # a value is sought within this factor of the case's
+MAX_GROWTH = 6  # the fit's grid is widened at most this many times (each at least doubles the domain)
+GROWTH_MARGIN = 4.0  # a grown grid holds the wear of the trial that outgrew it with its coefficients this much larger
+GRID_EDGE = "edge of the grid"  # in the message of a run whose contact reached it (fretsim.loop.checks.check_edges)
+
+
+class _Outgrown(Exception):
+    """A trial's contact reached the edge of the fit's grid (``logs``: the trial's ln values)."""
+
+    def __init__(self, logs):
+        super().__init__("outgrown")
+        self.logs = logs
 MAX_ROWS = 10_000  # rows of measurements: an exported history of a long run has a few hundred
 _HEADER = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(?:\[\s*([^\]]*)\s*\])?\s*$")
 
@@ -244,6 +256,8 @@ def _model(case: Case, measured: Measured) -> np.ndarray:
     wall = getattr(case.geometry, "wall", None)
     obs = _Collect(measured, wall)
     out = run(case, None, observers=(obs,))
+    if out.status != "complete" and GRID_EDGE in out.message:
+        raise _Outgrown(None)
     if out.status != "complete":
         raise RuntimeError(f"a run of the fit stopped: {out.message}")
     res = []
@@ -350,9 +364,7 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
     tops = [f"{k}={_written(v * RANGE, s.kind)}" for k, v, s in zip(keys, start, specs) if s.kind in WEAR_KINDS]
     if len(tops) == len(keys):  # a fitted load or stroke would wear beyond what the coefficients bound
         _check_scale(parse_case(case_text, source=source, overrides=[*base, *tops]), measured)
-    fixed, grown = _fixed_choices(case_text, source, base, case0, tops)
-    if grown and note is not None:
-        note(grown)
+    grid = _Grid(case_text, source, base, case0)
     runs = [0]
     cache: dict = {}
 
@@ -362,8 +374,10 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
             vals = np.exp(logs)
             sets = [f"{k}={_written(v, s.kind)}" for k, v, s in zip(keys, vals, specs)]
             try:
-                case = parse_case(case_text, source=source, overrides=[*base, *fixed, *sets])
+                case = parse_case(case_text, source=source, overrides=[*base, *grid.choices, *sets])
                 cache[key] = _model(case, measured)
+            except _Outgrown:
+                raise _Outgrown(logs) from None
             except (CaseError, SimulationError) as exc:
                 raise RuntimeError(f"at {', '.join(sets)}: {exc}") from None
             runs[0] += 1
@@ -373,8 +387,24 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
 
     x0 = np.log(start)
     lo, hi = x0 - math.log(RANGE), x0 + math.log(RANGE)
-    sol = least_squares(evaluate, x0, bounds=(lo, hi), diff_step=DIFF_STEP, x_scale=1.0, xtol=1e-6, ftol=1e-8,
-                        max_nfev=200)
+    while True:  # started again on a wider grid when a trial outgrows it (the runs so far were on another grid)
+        try:
+            sol = least_squares(evaluate, x0, bounds=(lo, hi), diff_step=DIFF_STEP, x_scale=1.0, xtol=1e-6,
+                                ftol=1e-8, max_nfev=200)
+            break
+        except _Outgrown as exc:
+            trial = np.exp(exc.logs)
+            tops = [f"{k}={_written(v * GROWTH_MARGIN, s.kind)}" for k, v, s in zip(keys, trial, specs)
+                    if s.kind in WEAR_KINDS]
+            said = grid.grow(tops) if len(tops) == len(keys) else ""
+            if not said:
+                raise RuntimeError(f"a run of the fit stopped: the contact reached the edge of the grid at "
+                                   f"{', '.join(f'{k}={v:.4g}' for k, v in zip(keys, trial))}; give grid.domain "
+                                   f"(wider) and grid.elements") from None
+            if note is not None:
+                note(said)
+            cache.clear()
+            x0 = np.clip(exc.logs, lo, hi)
     r = evaluate(sol.x)
     low, high, dof, message = _intervals(sol, r, len(keys))
     at_bound = [k for k, x, a, b in zip(keys, sol.x, lo, hi) if min(x - a, b - x) < 1e-3]
@@ -429,27 +459,49 @@ def _check_scale(top: Case, measured: Measured) -> None:
         raise CaseError(measured.source, list(problems.values()), "measurements")
 
 
-def _fixed_choices(case_text: str, source: str, base: list, case0: Case, tops: list) -> tuple[list[str], str]:
-    """The grid and the automatic choices, fixed once at the starting values: every run compares like with like.
-    An automatic grid's domain holds the wear of ``tops`` (the wear coefficients at the top of the search); the
-    second item says so when that grid is larger than the starting values' ("" otherwise)."""
-    from fretsim.plan import prepare
-    _, filled, _ = prepare(parse_case(case_text, source=source, overrides=base))
-    corrections = "none" if not filled.corrections or filled.corrections == "none" else list(filled.corrections)
-    model = [f"model.dimension={filled.dimension}", f"model.corrections={corrections}", f"model.slip={filled.slip}",
-             # the paper's mid-stroke gap is unstable where the moving body wears too little, which a search over
-             # the coefficients can reach: the stroke-averaged gap is stable for any (unless the case names one)
-             f"model.gap={case0.gap_model if case0.gap_model != 'auto' else 'stroke_average'}"]
-    domain, elements = filled.domain, filled.elements
-    if case0.domain is None and case0.elements is None:  # a grid the case gives stays the case's
-        domain, elements = _holding(parse_case(case_text, source=source, overrides=[*base, *model, *tops]), filled)
-    grown = "" if tuple(elements) == tuple(filled.elements) else (
-        f"the fit's grid holds the wear of {', '.join(t.split('=')[0] for t in tops)} at {RANGE:g}× the starting "
-        f"value (the top of the search): {' × '.join(map(str, elements))} elements of the starting grid's size, "
-        f"where the starting values need {' × '.join(map(str, filled.elements))}, so a 3D run costs more; give "
-        f"grid.domain and grid.elements to choose the grid")
-    return [*model, f"grid.domain=[{', '.join(f'{d!r} mm' for d in domain)}]",
-            f"grid.elements=[{', '.join(map(str, elements))}]"], grown
+class _Grid:
+    """The fit's grid and automatic choices, fixed at the starting values so that every run compares like with
+    like, and grown (the starting element over a wider domain) when a trial's scar outgrows it: sizing it for the
+    top of the search up front cost every 3D fit about its elements' ratio (McColl 185 N 3D: 3991 × 27 elements
+    instead of 427 × 27, 2.6× a run; a ball ~28×), where a search from a fair guess never goes there."""
+
+    def __init__(self, case_text: str, source: str, base: list, case0: Case):
+        from fretsim.plan import prepare
+        _, self.filled, _ = prepare(parse_case(case_text, source=source, overrides=base))
+        f = self.filled
+        corrections = "none" if not f.corrections or f.corrections == "none" else list(f.corrections)
+        self.model = [f"model.dimension={f.dimension}", f"model.corrections={corrections}", f"model.slip={f.slip}",
+                      # the paper's mid-stroke gap is unstable where the moving body wears too little, which a search
+                      # over the coefficients can reach: the stroke-averaged gap is stable for any (unless named)
+                      f"model.gap={case0.gap_model if case0.gap_model != 'auto' else 'stroke_average'}"]
+        self.given = case0.domain is not None or case0.elements is not None  # a grid the case gives stays its own
+        self.case_text, self.source, self.base = case_text, source, base
+        self.domain, self.elements, self.grown = f.domain, f.elements, 0
+
+    @property
+    def choices(self) -> list[str]:
+        return [*self.model, f"grid.domain=[{', '.join(f'{d!r} mm' for d in self.domain)}]",
+                f"grid.elements=[{', '.join(map(str, self.elements))}]"]
+
+    def grow(self, tops: list) -> str:
+        """Widen the domain to hold the wear of ``tops`` (``key=value`` of the wear coefficients, beyond the trial
+        that outgrew the grid); what it did, for a note ("" where the grid is the case's or at its limit)."""
+        if self.given or self.grown >= MAX_GROWTH:
+            return ""
+        top = parse_case(self.case_text, source=self.source, overrides=[*self.base, *self.model, *tops])
+        holding, _ = _holding(top, self.filled)
+        wider = [h > d * (1 + 1e-9) for h, d in zip(holding, self.domain)] or [True]
+        if not any(wider):  # the estimate holds it, the run did not: along the stroke, where scars grow
+            wider[0] = True
+        # each axis that grows at least doubles: a search that creeps outward restarts a few times, not many
+        domain = [max(h, 2.0 * d) if w else d for h, d, w in zip(holding, self.domain, wider)]
+        steps = [d / n for d, n in zip(self.filled.domain, self.filled.elements)]
+        self.elements = tuple(max(_odd(d / h), n) for d, h, n in zip(domain, steps, self.elements))
+        self.domain = tuple(n * h for n, h in zip(self.elements, steps))
+        self.grown += 1
+        return (f"a trial's scar reached the edge of the fit's grid: the fit starts again on "
+                f"{' × '.join(map(str, self.elements))} elements of the same size (give grid.domain and "
+                f"grid.elements to choose the grid)")
 
 
 def _holding(top: Case, filled: Case) -> tuple[tuple, tuple]:
@@ -468,11 +520,6 @@ def _holding(top: Case, filled: Case) -> tuple[tuple, tuple]:
     steps = [d / n for d, n in zip(filled.domain, filled.elements)]
     elements = tuple(_odd(max(d, wide) / step) for d, wide, step in zip(filled.domain, sizing.domain, steps))
     return tuple(n * step for n, step in zip(elements, steps)), elements
-
-
-def _odd(n: float) -> int:
-    n = max(int(math.ceil(n - 1e-9)), 1)  # the centre line on an element's centre, as the planner's grids
-    return n if n % 2 else n + 1
 
 
 def _intervals(sol, r: np.ndarray, p: int) -> tuple[np.ndarray, np.ndarray, int, str]:
