@@ -348,7 +348,6 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
     -------
     FitResult : the values, their 95 % confidence intervals, the residuals and a message.
     """
-    from scipy.optimize import least_squares
     keys = tuple(keys)
     specs = [_spec(k) for k in keys]
     cycles = sorted(set(measured.cycles.tolist()))
@@ -387,11 +386,26 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
 
     x0 = np.log(start)
     lo, hi = x0 - math.log(RANGE), x0 + math.log(RANGE)
-    while True:  # started again on a wider grid when a trial outgrows it (the runs so far were on another grid)
+    sol = _search(evaluate, x0, (lo, hi), grid, keys, specs, note, cache)
+    r = evaluate(sol.x)
+    low, high, dof, message = _intervals(sol, r, len(keys))
+    at_bound = [k for k, x, a, b in zip(keys, sol.x, lo, hi) if min(x - a, b - x) < 1e-3]
+    if at_bound:
+        message = (f"{', '.join(at_bound)} ended at the edge of the search ({RANGE:g}× from the start): the model "
+                   f"cannot reproduce the data with values in that range (see the residuals); the values are "
+                   f"not a fit" + (f"; {message}" if message else ""))
+    return FitResult(keys, start, np.exp(sol.x), low, high, r, cache[tuple(np.round(sol.x, 12))], measured, runs[0],
+                     dof, message or sol.message, tuple(s.kind for s in specs), tuple(overrides))
+
+
+def _search(evaluate, x0, bounds, grid: "_Grid", keys, specs, note, cache: dict):
+    """The least-squares search, started again on a wider grid whenever a trial outgrows the fit's (the runs so
+    far, on another grid, are forgotten)."""
+    from scipy.optimize import least_squares
+    while True:
         try:
-            sol = least_squares(evaluate, x0, bounds=(lo, hi), diff_step=DIFF_STEP, x_scale=1.0, xtol=1e-6,
-                                ftol=1e-8, max_nfev=200)
-            break
+            return least_squares(evaluate, x0, bounds=bounds, diff_step=DIFF_STEP, x_scale=1.0, xtol=1e-6, ftol=1e-8,
+                                 max_nfev=200)
         except _Outgrown as exc:
             trial = np.exp(exc.logs)
             tops = [f"{k}={_written(v * GROWTH_MARGIN, s.kind)}" for k, v, s in zip(keys, trial, specs)
@@ -404,16 +418,7 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
             if note is not None:
                 note(said)
             cache.clear()
-            x0 = np.clip(exc.logs, lo, hi)
-    r = evaluate(sol.x)
-    low, high, dof, message = _intervals(sol, r, len(keys))
-    at_bound = [k for k, x, a, b in zip(keys, sol.x, lo, hi) if min(x - a, b - x) < 1e-3]
-    if at_bound:
-        message = (f"{', '.join(at_bound)} ended at the edge of the search ({RANGE:g}× from the start): the model "
-                   f"cannot reproduce the data with values in that range (see the residuals); the values are "
-                   f"not a fit" + (f"; {message}" if message else ""))
-    return FitResult(keys, start, np.exp(sol.x), low, high, r, cache[tuple(np.round(sol.x, 12))], measured, runs[0],
-                     dof, message or sol.message, tuple(s.kind for s in specs), tuple(overrides))
+            x0 = np.clip(exc.logs, *bounds)
 
 
 def _check_columns(case: Case, measured: Measured) -> None:
