@@ -1,7 +1,8 @@
 """Does cycle jumping carry the resolved stroke's depth?  McColl 185 N 2D (μ = 0.9, Coulomb), on one grid (427
 elements over 0.7018 mm, the automatic accuracy grid), over N cycles: the run cycle by cycle (linear jumps of one
 cycle: each cycle's wear from its own contact, the model's own answer) against BDF2 and implicit steps at several
-jumping.tolerance, with each run's own stepping estimate; the mid-stroke model beside it as the control.
+jumping.tolerance, and explicit steps (linear below its stability limit of 4.4 cycles here, adaptive), with each
+run's own stepping estimate; the mid-stroke model beside it as the control.
 
     python scripts/study_resolved_stepping.py [--cycles 1000] [--quick]
 
@@ -37,6 +38,9 @@ def main(cycles: int, quick: bool) -> None:
     say = Report()
     per_cycle = ["jumping.scheme=linear", "jumping.linear=1"]
     schemes = [("cycle by cycle", per_cycle), ("bdf2, tolerance 0.01", ["jumping.scheme=bdf2"]),
+               ("linear, 4 cycles", ["jumping.scheme=linear", "jumping.linear=4"]),
+               ("adaptive", ["jumping.scheme=adaptive"]),
+               ("implicit, tolerance 0.01", ["jumping.scheme=implicit"]),
                ("bdf2, tolerance 0.001", ["jumping.scheme=bdf2", "jumping.tolerance=0.001"])]
     if not quick:
         schemes += [("bdf2, tolerance 1e-4", ["jumping.scheme=bdf2", "jumping.tolerance=0.0001"]),
