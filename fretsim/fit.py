@@ -360,7 +360,7 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
         raise CaseError(source, [(k, "a fitted value must start above 0") for k, v in zip(keys, start) if v <= 0],
                         "fit")
     _check_columns(case0, measured)
-    tops = [f"{k}={_written(v * RANGE, s.kind)}" for k, v, s in zip(keys, start, specs) if s.kind in WEAR_KINDS]
+    tops = [_top(k, v * RANGE, s) for k, v, s in zip(keys, start, specs) if s.kind in WEAR_KINDS]
     if len(tops) == len(keys):  # a fitted load or stroke would wear beyond what the coefficients bound
         _check_scale(parse_case(case_text, source=source, overrides=[*base, *tops]), measured)
     grid = _Grid(case_text, source, base, case0)
@@ -408,8 +408,7 @@ def _search(evaluate, x0, bounds, grid: "_Grid", keys, specs, note, cache: dict)
                                  max_nfev=200)
         except _Outgrown as exc:
             trial = np.exp(exc.logs)
-            tops = [f"{k}={_written(v * GROWTH_MARGIN, s.kind)}" for k, v, s in zip(keys, trial, specs)
-                    if s.kind in WEAR_KINDS]
+            tops = [_top(k, v * GROWTH_MARGIN, s) for k, v, s in zip(keys, trial, specs) if s.kind in WEAR_KINDS]
             said = grid.grow(tops) if len(tops) == len(keys) else ""
             if not said:
                 raise RuntimeError(f"a run of the fit stopped: the contact reached the edge of the grid at "
@@ -419,6 +418,13 @@ def _search(evaluate, x0, bounds, grid: "_Grid", keys, specs, note, cache: dict)
                 note(said)
             cache.clear()
             x0 = np.clip(exc.logs, *bounds)
+
+
+def _top(key: str, value: float, spec: Key) -> str:
+    """``key=value`` for a case that bounds the search's wear, capped at the key's plausible top: the case reader
+    refuses beyond it, and no run of the search can go there either (its runs are cases too)."""
+    cap = spec.plausible[1] if spec.plausible else math.inf
+    return f"{key}={_written(min(value, cap), spec.kind)}"
 
 
 def _check_columns(case: Case, measured: Measured) -> None:

@@ -232,3 +232,14 @@ def test_the_fits_grid_is_widened_only_when_a_trial_outgrows_it(truth):
         assert res.converged and bool(notes) == widened, (factor, notes, res.message)
         for true, lo, hi in zip((K_MOVING, K_STATIONARY), res.low, res.high):
             assert lo <= true <= hi, (factor, true, lo, hi)
+
+
+def test_a_start_whose_top_of_the_search_is_beyond_the_plausible_range_is_searched_not_refused(truth):
+    """A starting coefficient of 2e-7 1/MPa puts the top of the search (1000×) beyond the case reader's plausible
+    1e-4: the unit-slip check built that case and refused the fit before any run, naming a value the user never
+    gave.  The bound is capped at the plausible top, and the fit runs (here down to the truth's 1.2e-8)."""
+    measured = read_measured(truth / "measured.csv")
+    start = [TWO_D, f"materials.moving.wear_coefficient={K_MOVING} 1/MPa",
+             "materials.stationary.wear_coefficient=2e-7 1/MPa"]
+    res = fit(CASE.read_text(), str(CASE), measured, keys=("materials.stationary.wear_coefficient",), overrides=start)
+    assert res.low[0] <= K_STATIONARY <= res.high[0], (res.values, res.low, res.high, res.message)

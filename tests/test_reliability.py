@@ -1,6 +1,7 @@
 """Nothing lost, nothing silently wrong (issue #13): each break found by the attack on the landed CLI, reproduced."""
 import errno
 import json
+import math
 import os
 import signal
 import subprocess
@@ -192,6 +193,17 @@ def test_a_resumed_run_keeps_every_automatic_choice_its_reason_and_auto_s_error(
     assert b.attrs["notes"] == a.attrs["notes"]
     for key in ("estimated_error_depth", "estimated_error_width", "centre_wear_depth_stationary_um"):
         assert b.summary[key] == a.summary[key], key
+    # a file interrupted before /choices/error was recorded: auto's model difference is unknown, and so are the
+    # totals it enters, rather than taken as 0 (which made the resumed depth estimate 30× smaller)
+    with pytest.raises(KeyboardInterrupt):
+        run(load_case(CASE, sets), tmp_path / "old.h5", observers=(_CtrlC(12),))
+    with edited(tmp_path / "old.h5") as f:
+        del f["choices/error"]
+        _seal(f)
+    assert resume(tmp_path / "old.h5").status == "complete"
+    c = read_results(tmp_path / "old.h5")
+    assert c.choices == a.choices and math.isnan(c.summary["estimated_error_depth"])
+    assert math.isfinite(c.summary["estimated_error_pressure"])
 
 
 def test_two_ctrl_c_in_quick_succession_leave_a_consistent_interrupted_file(tmp_path):

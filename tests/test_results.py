@@ -253,8 +253,9 @@ def test_dimension_is_accepted_in_capitals():
 def test_a_format_1_1_file_is_still_read(results_3d, tmp_path):
     old = tmp_path / "v11.h5"
     old.write_bytes(results_3d.read_bytes())
-    with edited(old) as f:  # what the 1.1 writer made: none of 1.2's, 1.3's or 1.4's additions
-        for path in ("inputs", "choices", "history/error_estimate_depth", "history/error_estimate_pressure",
+    with edited(old) as f:  # what the 1.1 writer made: none of 1.2's, 1.3's or 1.4's additions (its /choices had
+        #                     key, value, reason and given)
+        for path in ("inputs", "choices/error", "history/error_estimate_depth", "history/error_estimate_pressure",
                      "fields/x", "fields/y", "history/block", "history/dissipated_energy_J", "history/wear_work",
                      "fields/slip_distance_moving", "fields/slip_distance_stationary", "fields/shear_traction",
                      "fretting_loop"):
@@ -273,7 +274,7 @@ def test_a_format_1_1_file_is_still_read(results_3d, tmp_path):
             g.attrs[key] = value
     assert legacy.read_bytes()[:4] == b"\x89HDF"
     res = read_results(legacy)
-    assert res.summary["cycles"] == 1000 and res.inputs == {}
+    assert res.summary["cycles"] == 1000 and res.inputs == {} and res.choices  # 1.1 wrote /choices already
 
 
 def _names(f) -> list:

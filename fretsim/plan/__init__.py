@@ -110,8 +110,9 @@ def restore(setup: Setup, plan: Plan, provenance: list, notes: str = "") -> tupl
     for c in plan.choices:
         if c.key in recorded:
             value, reason, given, error = recorded[c.key]
-            c = dataclasses.replace(c, value=value if given else c.value, reason=reason, given=bool(given),
-                                    error=float(error))
+            # an automatic choice whose accepted model difference was not recorded: unknown, so are the totals
+            error = 0.0 if given else float("nan") if error is None else float(error)
+            c = dataclasses.replace(c, value=value if given else c.value, reason=reason, given=bool(given), error=error)
         choices.append(c)
     plan = dataclasses.replace(plan, choices=choices)
     return dataclasses.replace(setup, notes=tuple(notes.split("\n")) if notes else _notes(plan)), plan

@@ -197,7 +197,9 @@ def _read(f, path: str, for_resume: bool) -> Results:
         choices = list(zip(*cols))
         n = len(choices)
         given = (_dataset(f, "choices/given", 1).astype(bool).tolist() if "given" in f["choices"] else [None] * n)
-        error = (_dataset(f, "choices/error", 1).astype(float).tolist() if "error" in f["choices"] else [0.0] * n)
+        # absent (written before it was recorded): unknown, not 0, so a resume does not drop auto's model part
+        error = (_dataset(f, "choices/error", 1, allow_nan=True).astype(float).tolist() if "error" in f["choices"]
+                 else [None] * n)
         if len(given) != n or len(error) != n:
             raise _Damaged(f"/choices: {n} keys but {len(given)} given flags and {len(error)} errors")
         provenance = [(*c, g, e) for c, g, e in zip(choices, given, error)]
@@ -212,7 +214,7 @@ def _read(f, path: str, for_resume: bool) -> Results:
 _FORMAT_MARKS = {
     "1.4": (lambda f: isinstance(f.get("history"), h5py.Group) and "block" in f["history"], "/history/block"),
     "1.3": (lambda f: "fretting_loop" in f or _any_checksum(f), "/fretting_loop or the checksums of every object"),
-    "1.2": (lambda f: "choices" in f or "inputs" in f, "/choices or /inputs"),
+    "1.2": (lambda f: "inputs" in f, "/inputs"),  # /choices is older: 1.1 wrote it
 }
 
 
