@@ -864,7 +864,10 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
         r.fail("expected", f"expected a mapping of published values, got {excerpt(expected)}")
         expected = {}
     scheme, preset = _scheme(jumping, raw.get("jumping") if isinstance(raw.get("jumping"), dict) else {})
-    _check_model(r, geometry, materials, model, load.get("friction_coefficient"))
+    mu = load.get("friction_coefficient")
+    if mu is None and blocks and all(b.friction_coefficient is not None for b in blocks):
+        mu = min(b.friction_coefficient for b in blocks)  # every block gives its own: the history has friction
+    _check_model(r, geometry, materials, model, mu)
     domain = grid.get("domain")
     stroke = load.get("stroke")
     if domain is not None and stroke is not None and stroke >= domain[0] / 2:

@@ -504,3 +504,12 @@ def test_a_history_with_friction_in_some_blocks_only_is_refused_naming_the_first
     # given once for the loading, every block has it: accepted
     case("loading:\n  friction_coefficient: 0.9\n  blocks:\n    - {normal_load: 100 N, stroke: 10 um, cycles: 1}\n"
          "    - {normal_load: 100 N, stroke: 25 um, cycles: 1, friction_coefficient: 0.5}\n")
+
+
+def test_a_history_with_friction_on_every_block_takes_coulomb_friction_when_asked():
+    """With μ on every block and none for the loading, auto chose Coulomb friction and ran it, but asking for it
+    (model.slip coulomb) was refused as 'loading.friction_coefficient: missing'."""
+    history = ("loading:\n  blocks:\n    - {normal_load: 185 N, stroke: 25 um, cycles: 5, friction_coefficient: 0.9}\n"
+               "    - {normal_load: 100 N, stroke: 25 um, cycles: 5, friction_coefficient: 0.5}\n")
+    out = run(case(history, overrides=["model.slip=coulomb"]))
+    assert out.status == "complete" and out.case.slip == "coulomb", out.message
