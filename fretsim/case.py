@@ -408,7 +408,7 @@ class Case:
             "jumping": jumping,
             "grid": grid,
             "output": {"snapshots": list(self.snapshots) if self.snapshots is not None else "auto"},
-            **({"limits": {k: (f"{v!r}" if LIMITS_SCHEMA[k].kind == "fraction" else
+            **({"limits": {k: (float(v) if LIMITS_SCHEMA[k].kind == "fraction" else  # a number: '0.4' is refused
                                format_quantity(v, LIMITS_SCHEMA[k].kind)) for k, v in self.limits}}
                if self.limits else {}),
         }

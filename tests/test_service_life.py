@@ -513,3 +513,14 @@ def test_a_history_with_friction_on_every_block_takes_coulomb_friction_when_aske
                "    - {normal_load: 100 N, stroke: 25 um, cycles: 5, friction_coefficient: 0.5}\n")
     out = run(case(history, overrides=["model.slip=coulomb"]))
     assert out.status == "complete" and out.case.slip == "coulomb", out.message
+
+
+def test_a_case_with_a_wall_loss_limit_reads_back_from_its_own_filled_yaml():
+    """--resume reads the case stored in the file: a wall loss limit was written as the text '0.4', which the
+    reader refuses ("expected a plain number"), so no run with a wall loss limit could be resumed."""
+    from pathlib import Path
+    from fretsim.api import load_case
+    tube = load_case(Path(__file__).resolve().parent.parent / "cases" / "tube_service_RT.yaml")
+    assert dict(tube.limits).get("wall_loss") is not None
+    again = parse_case(tube.to_yaml(), source="stored")
+    assert dict(again.limits) == dict(tube.limits)
