@@ -133,10 +133,13 @@ def figures(res: Results, log_cycles: bool = False, names=None) -> dict:
     for name, fig in out.items():
         fig.suptitle(title, fontsize=9)
         # fixed margins: a layout engine redraws every figure several times (twice the time, measured)
-        rows = len({ax.get_subplotspec().rowspan.start for ax in fig.axes if ax.get_subplotspec()})
+        # the panels' rows (a colorbar's own axes is not a row: counted as one, it took the bottom margin of two
+        # rows and the 3D fretting figure's x labels fell off the canvas)
+        specs = [ax.get_subplotspec() for ax in fig.axes if ax.get_subplotspec()]
+        rows = specs[0].get_gridspec().nrows if specs else 1
         top = 1 - (0.45 + 0.18 * (1 + title.count("\n"))) / fig.get_figheight()
         fig.subplots_adjust(left=0.07 if name != "maps" else 0.05, right=0.97 if name != "maps" else 0.95,
-                            bottom=0.09 if rows > 1 else 0.13, top=top, hspace=0.42,
+                            bottom=0.09 if rows > 1 else 0.14, top=top, hspace=0.42,
                             wspace=0.22 if name != "maps" else 0.08)
     return out
 

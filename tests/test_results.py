@@ -449,3 +449,23 @@ def test_plot_overlays_several_runs_and_the_published_values(results_3d, tmp_pat
 def centre_row_of(res):
     from fretsim.measures import centre_line
     return centre_line(res.fields["wear_depth_stationary"][-1])
+
+
+@pytest.mark.parametrize("dimension", ["2d", "3d"])
+def test_every_figure_draws_its_labels_inside_the_canvas(tmp_path, dimension):
+    """The 3D fretting figure's colorbar was counted as a second row of panels, which took the one-row bottom
+    margin away: its x labels fell off the canvas (4 px), and the history's x label lost its descenders."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from fretsim.plotting import figures
+    path = tmp_path / "r.h5"
+    run(load_case(CASE, [f"model.dimension={dimension}", "loading.friction_coefficient=0.9", "loading.cycles=300",
+                         "output.snapshots=[0, 150, 300]", "grid.error_estimate=none"]), path)
+    drawn = figures(read_results(path))
+    assert {"fretting", "history", "wear_profiles"} <= set(drawn)
+    for name, fig in drawn.items():
+        renderer = fig.canvas.get_renderer()
+        box = fig.get_tightbbox(renderer).transformed(fig.dpi_scale_trans)  # everything drawn, in pixels
+        inside = (box.x0 >= -0.5 and box.y0 >= -0.5 and box.x1 <= fig.bbox.width + 0.5
+                  and box.y1 <= fig.bbox.height + 0.5)
+        assert inside, (name, box.bounds, fig.bbox.bounds)
