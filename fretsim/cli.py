@@ -382,6 +382,18 @@ def _check_regime(setup, loading) -> str:
             f"gross-slip limit δ_t = {d_t * 1e3:.4g} µm (μ = {mu:g}, the unworn contact)")
 
 
+def _summary_value(key: str, value, row: dict) -> str:
+    """A value as `summary` prints it: "–" where none applies (JSON keeps null), the regime marked "(assumed)"
+    where no friction coefficient judged it."""
+    if value is None or value == "":
+        return "–"
+    if isinstance(value, float):
+        return f"{value:.6g}"
+    if key == "regime" and row.get("inputs", {}).get("friction_coefficient") is None:
+        return f"{value} (assumed)"
+    return str(value)
+
+
 def _regime(s: dict, c) -> str:
     """The regime sentence of the summary: measured (coulomb) or assumed (uniform slip)."""
     from fretsim.cycle import CYCLES
@@ -620,7 +632,7 @@ def summary(results_files: tuple, as_json: bool, as_csv: bool, debug: bool) -> N
             data = {k: v for k, v in r.items() if not isinstance(v, (dict, list))}
             width = max(len(k) for k in data)
             for k, v in data.items():
-                click.echo(f"{k:<{width}}  {v:.6g}" if isinstance(v, float) else f"{k:<{width}}  {v}")
+                click.echo(f"{k:<{width}}  {_summary_value(k, v, r)}")
             if r.get("inputs"):
                 click.echo("inputs  " + ", ".join(f"{k} {f'{v:.6g}' if isinstance(v, float) else v}"
                                                   f"{' ' + r['input_units'][k] if r['input_units'].get(k) and r['input_units'][k] != '1' else ''}"

@@ -364,3 +364,20 @@ def test_a_fault_composing_the_paragraph_after_a_complete_run_never_turns_it_int
                                   "grid.error_estimate=none"])
     assert r.exit_code == 0 and "fretsim summary" in r.output and "Traceback" not in r.output, r.output
     assert read_results(out).status == "complete"
+
+
+def test_summary_prints_a_dash_where_no_value_applies_and_marks_an_assumed_regime(tmp_path):
+    """It printed Python's None for a value that does not apply (no wear limit, the y element of a 2D run) and
+    'gross_slip' for a regime no friction coefficient judged; JSON keeps null and the bare regime."""
+    import json
+    out = tmp_path / "r.h5"
+    r = CliRunner().invoke(main, ["run", str(CASES / "mccoll_185N.yaml"), "-o", str(out), "--set", "model.dimension=2d",
+                                  "--set", "loading.cycles=100", "--set", "grid.error_estimate=none"])
+    assert r.exit_code == 0, r.output
+    text = CliRunner().invoke(main, ["summary", str(out)]).output
+    assert "None" not in text
+    rows = dict(line.split(None, 1) for line in text.splitlines() if line and not line.startswith(("inputs", "overrides")))
+    assert rows["cycles_to_limit"] == "–" and rows["element_size_y_um"] == "–"
+    assert rows["regime"] == "gross_slip (assumed)"
+    data = json.loads(CliRunner().invoke(main, ["summary", str(out), "--json"]).output)
+    assert data["cycles_to_limit"] is None and data["regime"] == "gross_slip"
