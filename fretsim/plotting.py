@@ -9,8 +9,8 @@ returns the matplotlib figures (tests check what is drawn), :func:`plot_all` sav
 from __future__ import annotations
 
 import math
-
 import os
+import textwrap
 import threading
 from pathlib import Path
 from typing import Optional
@@ -64,12 +64,11 @@ def title_block(res: Results) -> str:
                      f"{_input(res, 'scheme', '')}")
     elif res.inputs:
         parts.append(f"P = {_number(res, 'normal_load', '.4g')} N, δ = ±{_number(res, 'stroke', '.4g')} µm, "
-                     f"N = {_number(res, 'cycles', '.0f')}, k_m = {_number(res, 'moving_wear_coefficient', '.3g')}, "
-                     f"k_s = {_number(res, 'stationary_wear_coefficient', '.3g')} 1/MPa; "
+                     f"N = {_number(res, 'cycles', '.0f')}, {_coefficients(res)}; "
                      f"{str(_input(res, 'dimension', '')).upper()} {_input(res, 'geometry', '')}, gap "
                      f"{_input(res, 'gap_model', '')}, {_input(res, 'scheme', '')}")
-    if res.overrides:
-        parts.append("--set " + " ".join(res.overrides))
+    if res.overrides:  # wrapped: a long --set line ran off the figure's top
+        parts += textwrap.wrap("--set " + " ".join(res.overrides), TITLE_WIDTH, break_long_words=False)
     est = [(label, res.summary.get(f"estimated_error_{key}")) for label, key in
            (("depth", "depth"), ("width", "width"), ("pressure", "pressure"), ("peak pressure", "max_pressure"))]
     if all(isinstance(v, float) and math.isfinite(v) for _, v in est):
@@ -78,6 +77,18 @@ def title_block(res: Results) -> str:
     if res.summary.get("limit_reached"):
         parts.append(f"wear limit {res.summary['limit_reached']} reached at N = {res.summary['cycles_to_limit']:,.0f}")
     return "\n".join(parts)
+
+
+TITLE_WIDTH = 150  # characters of a title line at fontsize 9 across the narrowest figure (11 in)
+
+
+def _coefficients(res: Results) -> str:
+    """The wear law's coefficients: Archard's k (1/MPa), or the energy law's α (mm³/J), which is what it runs on."""
+    if _input(res, "wear_law", "archard") == "energy" and _float(res, "moving_energy_wear_coefficient") is not None:
+        return (f"α_m = {_number(res, 'moving_energy_wear_coefficient', '.3g')}, α_s = "
+                f"{_number(res, 'stationary_energy_wear_coefficient', '.3g')} mm³/J")
+    return (f"k_m = {_number(res, 'moving_wear_coefficient', '.3g')}, k_s = "
+            f"{_number(res, 'stationary_wear_coefficient', '.3g')} 1/MPa")
 
 
 def _percent(v: float) -> str:

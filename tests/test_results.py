@@ -469,3 +469,23 @@ def test_every_figure_draws_its_labels_inside_the_canvas(tmp_path, dimension):
         inside = (box.x0 >= -0.5 and box.y0 >= -0.5 and box.x1 <= fig.bbox.width + 0.5
                   and box.y1 <= fig.bbox.height + 0.5)
         assert inside, (name, box.bounds, fig.bbox.bounds)
+
+
+def test_the_title_names_the_energy_laws_alpha_and_wraps_a_long_set_line_inside_the_canvas(tmp_path):
+    """The energy law's figures showed Archard's k_m, k_s in their title (the law runs on α), and a long --set
+    line ran off the figure's top."""
+    import matplotlib
+    matplotlib.use("Agg")
+    from fretsim.plotting import TITLE_WIDTH, figures, title_block
+    path = tmp_path / "r.h5"
+    sets = ["model.dimension=2d", "loading.friction_coefficient=0.9", "model.wear_law=energy",
+            "materials.moving.energy_wear_coefficient=2e-5 mm3/J", "materials.stationary.energy_wear_coefficient=3e-5 "
+            "mm3/J", "loading.cycles=300", "output.snapshots=[0, 150, 300]", "grid.error_estimate=none"]
+    CliRunner().invoke(main, ["run", str(CASE), "-o", str(path), *[a for s in sets for a in ("--set", s)]])
+    res = read_results(path)
+    title = title_block(res)
+    assert "α_m = 2e-05" in title and "mm³/J" in title and "k_m" not in title, title
+    assert len(title.splitlines()) >= 4 and all(len(line) <= TITLE_WIDTH for line in title.splitlines()), title
+    for name, fig in figures(res).items():
+        box = fig.get_tightbbox(fig.canvas.get_renderer()).transformed(fig.dpi_scale_trans)
+        assert box.y1 <= fig.bbox.height + 0.5 and box.x1 <= fig.bbox.width + 0.5, (name, box.bounds)
