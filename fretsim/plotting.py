@@ -20,7 +20,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.ticker import MaxNLocator, ScalarFormatter  # noqa: E402
+from matplotlib.ticker import FuncFormatter, MaxNLocator, ScalarFormatter  # noqa: E402
 
 from fretsim.measures import centre_line  # noqa: E402
 from fretsim.quantities import SUMMARY  # noqa: E402
@@ -103,6 +103,22 @@ def _unit(res: Results, key: str) -> str:
 def _snapshot_lines(ax, x, curves, labels, sign=1.0):
     for k, (c, label) in enumerate(zip(curves, labels)):
         ax.plot(x, sign * c, ls=STYLES[k % len(STYLES)], lw=1.4, label=label)
+
+
+_SUPERSCRIPT = str.maketrans("0123456789-", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻")
+
+
+def cycles_tick(v: float) -> str:
+    """A cycle count on an axis as it reads: 20 000 up to 10⁵, then 2.5×10⁸ and 10⁹ (a service life's
+    1000000000 was a row of zeros to count)."""
+    if abs(v) < 1e5:
+        return f"{v:,.0f}".replace(",", " ")
+    exponent = int(math.floor(math.log10(abs(v))))
+    mantissa = round(v / 10 ** exponent, 2)
+    if abs(mantissa) >= 10:
+        mantissa, exponent = mantissa / 10, exponent + 1
+    power = "10" + str(exponent).translate(_SUPERSCRIPT)
+    return power if mantissa == 1 else f"{mantissa:g}×{power}"
 
 
 def _cycles_label(n: int) -> str:
@@ -500,10 +516,7 @@ def _history(res: Results, log_cycles: bool):
         if log_cycles:
             ax.set_xscale("log")
         else:
-            fmt = ScalarFormatter(useMathText=False)
-            fmt.set_scientific(False)
-            ax.xaxis.set_major_formatter(fmt)
-            ax.ticklabel_format(axis="x", style="plain")
+            ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: cycles_tick(v)))
             ax.tick_params(axis="x", labelrotation=20)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)

@@ -489,3 +489,12 @@ def test_the_title_names_the_energy_laws_alpha_and_wraps_a_long_set_line_inside_
     for name, fig in figures(res).items():
         box = fig.get_tightbbox(fig.canvas.get_renderer()).transformed(fig.dpi_scale_trans)
         assert box.y1 <= fig.bbox.height + 0.5 and box.x1 <= fig.bbox.width + 0.5, (name, box.bounds)
+
+
+def test_cycle_ticks_read_as_powers_of_ten_past_a_hundred_thousand(results_3d):
+    """A service life's history axis read 1000000000: from 10⁵ on, ticks read 2.5×10⁸ and 10⁹."""
+    from fretsim.plotting import cycles_tick, figures
+    assert [cycles_tick(v) for v in (0, 20000, 1e5, 2.5e8, 1e9, 1.5e9)] == ["0", "20 000", "10⁵", "2.5×10⁸", "10⁹",
+                                                                          "1.5×10⁹"]
+    history = figures(read_results(results_3d), names=["history"])["history"]
+    assert history.axes[0].xaxis.get_major_formatter()(1e9, 0) == "10⁹"
