@@ -602,8 +602,11 @@ def _fretting(res: Results):
     ax = axes[2]
     if three_d:
         slip = res.fields["slip_distance_moving"][last]
+        # from stuck (0) to the whole stroke (4δ): scaled to the data, a gross-slip map's 0.5 % variation took the
+        # full colour range and read as stick and slip
+        top = max(4 * stroke if stroke is not None else 0.0, float(np.nanmax(slip)) if slip.size else 0.0)
         pc = ax.pcolormesh(res.x, res.y, np.ma.masked_where(res.fields["pressure"][last] <= 0, slip), shading="nearest",
-                           cmap="viridis")
+                           cmap="viridis", vmin=0.0, vmax=top if top > 0 else None)
         fig.colorbar(pc, ax=ax, label=f"slip per cycle ({unit}); 0 = stuck")
         ax.set_ylabel("y (mm)")
         ax.set_title("stick and slip on the moving body")

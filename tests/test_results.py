@@ -452,7 +452,7 @@ def centre_row_of(res):
 
 
 @pytest.mark.parametrize("dimension", ["2d", "3d"])
-def test_every_figure_draws_its_labels_inside_the_canvas(tmp_path, dimension):
+def test_every_figure_draws_inside_its_canvas_and_the_slip_map_scales_from_stuck_to_the_stroke(tmp_path, dimension):
     """The 3D fretting figure's colorbar was counted as a second row of panels, which took the one-row bottom
     margin away: its x labels fell off the canvas (4 px), and the history's x label lost its descenders."""
     import matplotlib
@@ -463,6 +463,10 @@ def test_every_figure_draws_its_labels_inside_the_canvas(tmp_path, dimension):
                          "output.snapshots=[0, 150, 300]", "grid.error_estimate=none"]), path)
     drawn = figures(read_results(path))
     assert {"fretting", "history", "wear_profiles"} <= set(drawn)
+    if dimension == "3d":  # the slip map's scale runs from stuck to the whole stroke (4δ = 100 µm), not the data's
+        #                    0.5 % spread in gross slip
+        mesh = drawn["fretting"].axes[2].collections[0]
+        assert mesh.norm.vmin == 0.0 and mesh.norm.vmax >= 100.0 - 1e-9, (mesh.norm.vmin, mesh.norm.vmax)
     for name, fig in drawn.items():
         renderer = fig.canvas.get_renderer()
         box = fig.get_tightbbox(renderer).transformed(fig.dpi_scale_trans)  # everything drawn, in pixels
