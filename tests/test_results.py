@@ -473,6 +473,7 @@ def test_every_figure_draws_inside_its_canvas_and_the_slip_map_scales_from_stuck
         inside = (box.x0 >= -0.5 and box.y0 >= -0.5 and box.x1 <= fig.bbox.width + 0.5
                   and box.y1 <= fig.bbox.height + 0.5)
         assert inside, (name, box.bounds, fig.bbox.bounds)
+    _close(drawn)
 
 
 def test_the_title_names_the_energy_laws_alpha_and_wraps_a_long_set_line_inside_the_canvas(tmp_path):
@@ -490,9 +491,17 @@ def test_the_title_names_the_energy_laws_alpha_and_wraps_a_long_set_line_inside_
     title = title_block(res)
     assert "α_m = 2e-05" in title and "mm³/J" in title and "k_m" not in title, title
     assert len(title.splitlines()) >= 4 and all(len(line) <= TITLE_WIDTH for line in title.splitlines()), title
-    for name, fig in figures(res).items():
+    drawn = figures(res)
+    for name, fig in drawn.items():
         box = fig.get_tightbbox(fig.canvas.get_renderer()).transformed(fig.dpi_scale_trans)
         assert box.y1 <= fig.bbox.height + 0.5 and box.x1 <= fig.bbox.width + 0.5, (name, box.bounds)
+    _close(drawn)
+
+
+def _close(figs: dict) -> None:
+    import matplotlib.pyplot as plt
+    for fig in figs.values():
+        plt.close(fig)
 
 
 def test_cycle_ticks_read_as_powers_of_ten_past_a_hundred_thousand(results_3d):
@@ -500,5 +509,6 @@ def test_cycle_ticks_read_as_powers_of_ten_past_a_hundred_thousand(results_3d):
     from fretsim.plotting import cycles_tick, figures
     assert [cycles_tick(v) for v in (0, 20000, 1e5, 2.5e8, 1e9, 1.5e9)] == ["0", "20 000", "10⁵", "2.5×10⁸", "10⁹",
                                                                           "1.5×10⁹"]
-    history = figures(read_results(results_3d), names=["history"])["history"]
-    assert history.axes[0].xaxis.get_major_formatter()(1e9, 0) == "10⁹"
+    drawn = figures(read_results(results_3d), names=["history"])
+    assert drawn["history"].axes[0].xaxis.get_major_formatter()(1e9, 0) == "10⁹"
+    _close(drawn)
