@@ -501,7 +501,7 @@ class _Grid:
             return ""
         top = parse_case(self.case_text, source=self.source, overrides=[*self.base, *self.model, *tops])
         holding, _ = _holding(top, self.filled)
-        wider = [h > d * (1 + 1e-9) for h, d in zip(holding, self.domain)] or [True]
+        wider = [h > d * (1 + 1e-9) for h, d in zip(holding, self.domain)]
         if not any(wider):  # the estimate holds it, the run did not: along the stroke, where scars grow
             wider[0] = True
         # each axis that grows at least doubles: a search that creeps outward restarts a few times, not many
