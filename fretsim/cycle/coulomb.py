@@ -267,20 +267,28 @@ class CoulombCycle:
         return defect, mismatch
 
     def _tangential(self, q, p, du):
-        """One increment's traction, slip and stick set; rigid bodies (``slip: uniform``) slide with the rig."""
-        if self.rigid:
-            on = p > 0
-            return np.where(on, np.sign(du) * self.friction_coefficient * p, 0.0), np.where(on, du, 0.0), \
-                np.zeros(p.shape, bool), 0
+        """One increment's traction, its travel (the slip where in contact) and stick set; rigid bodies (``slip:
+        uniform``) slide with the rig.
+
+        The travel is every point's relative tangential displacement ΔU − KΔq, in contact or not: a point outside
+        the contact still moves with its body.  Taking it as 0 there (the solver's slip) left a point that lost
+        contact over the flat point where it left, so it re-entered the resolved stroke's contact reading the worn
+        flat up to the stroke away from where it was: the moving body's profile went rough at element scale and
+        the contact rattled between its spikes, worse on every finer grid (scripts/results/resolved_travel.txt)."""
         on = p > 0
+        if self.rigid:
+            return np.where(on, np.sign(du) * self.friction_coefficient * p, 0.0), np.full(p.shape, du), \
+                np.zeros(p.shape, bool), 0
         rhs = self.tangential(q) + du  # on the whole grid: the old traction may reach beyond the new contact
         rows, cols = _span(on.any(axis=1)), _span(on.any(axis=0))
         res = solve_tangential(self.tangential.window(rows, cols), rhs[rows, cols],
                                self.friction_coefficient * p[rows, cols], q[rows, cols], tol=self.tolerance)
         if not res.success:
             raise CycleError(f"the tangential contact did not converge: {res.message}")
-        q_new, ds, stuck = np.zeros(p.shape), np.zeros(p.shape), np.zeros(p.shape, bool)
-        q_new[rows, cols], ds[rows, cols], stuck[rows, cols] = res.traction, res.slip, res.stick
+        q_new, stuck = np.zeros(p.shape), np.zeros(p.shape, bool)
+        q_new[rows, cols], stuck[rows, cols] = res.traction, res.stick
+        ds = rhs - self.tangential(q_new)  # ΔU − KΔq everywhere (rhs = Kq + ΔU)
+        ds[rows, cols] = np.where(on[rows, cols], res.slip, ds[rows, cols])  # in contact: the solver's, 0 where stuck
         return q_new, ds, stuck, res.iterations
 
     def _response(self, step: float, w_lin, mismatch: np.ndarray) -> np.ndarray:
@@ -317,8 +325,9 @@ class _Tally:
         amount = member.law.amount(p, q_new, ds)
         self.rate_m += member.k_moving * amount
         self.rate_s += member.k_stationary * sweep.deposit(amount)
-        self.slip_m += np.abs(ds)
-        self.slip_s += sweep.deposit(np.abs(ds))
+        slid = np.where(p > 0, np.abs(ds), 0.0)  # slip is travel in contact
+        self.slip_m += slid
+        self.slip_s += sweep.deposit(slid)
         self.p_seen += share * sweep.deposit(p)
         self.energy += float((np.abs(q_new) * np.abs(ds)).sum()) * self.area
         self.work += float(amount.sum()) * self.area
