@@ -477,7 +477,6 @@ def _paragraph(outcome) -> str:
             f"{s['wall_time_s']:.2f} s" + (f" (and {s['grid_error_wall_time_s']:.2f} s for the grid-error companions)"
                                           if s.get("grid_error_wall_time_s", 0) >= 0.005 else "") + ".")
     text += " " + _regime(s, c)
-    singular = any(m.singular_pressure for m in outcome.setup.block_cycles or (outcome.setup.cycle,))
     if s["cycles"] > 0:
         text += (f" Stationary body: centre-line wear depth {s['centre_wear_depth_stationary_um']:.3g} µm "
                  f"(max {s['max_wear_depth_stationary_um']:.3g} µm), scar width {s['scar_width_stationary_mm']:.3g} mm,"
@@ -485,8 +484,7 @@ def _paragraph(outcome) -> str:
                  f"{s['centre_wear_depth_moving_um']:.3g} µm (max {s['max_wear_depth_moving_um']:.3g} µm), volume "
                  f"{s['wear_volume_moving_mm3']:.4g} mm³. Volume against its invariant "
                  f"({outcome.setup.cycle.invariant}): {s['archard_volume_error']:.1e}. "
-                 + ("Estimated error: not estimated for the resolved stroke (see the note)." if singular else
-                    _estimates(s)) + _limits(s, c))
+                 + _estimates(s) + _limits(s, c))
     else:
         text += f" Contact only: peak pressure {s['max_pressure_MPa']:.4g} MPa."
     return text + f" Results: {outcome.output}"

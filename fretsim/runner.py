@@ -307,17 +307,6 @@ def _simulate(setup, filled, plan, counter, sink: _Sink, observers, progress, st
     return "complete", ""
 
 
-# the resolved stroke under cycle jumping: implicit steps bias it beyond their own estimate, explicit ones do not
-# (scripts/results/resolved_stepping.txt), and the explicit schemes' estimates are not bounds either: no total is
-# reported rather than one that is too small
-RESOLVED_STEPPING = ("the resolved stroke's error is not estimated: implicit steps (bdf2, implicit) bias its depth "
-                     "far beyond their own estimate (McColl 185 N 2D, 1 000 cycles: +8.5 % and +6.8 % against the "
-                     "run cycle by cycle, estimated 0.1 %), explicit steps (jumping.scheme linear below its "
-                     "stability limit, or adaptive) agree with it within 0.1 % at about 8× the cost (README: the "
-                     "resolved stroke); the grid's companions were not run; for a depth to report use "
-                     "model.stroke: mid_stroke")
-
-
 def _estimate_errors(setup, filled, plan, counter, sink: _Sink, t0, runs: SideRuns) -> None:
     """The complete run's error estimates into ``counter.extra``; whatever stops them must not cost the run its
     file: the estimates are then unknown, and it says why."""
@@ -371,9 +360,6 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
     grid twice as coarse, see :mod:`fretsim.grid_error`) and the model difference ``auto`` accepted."""
     summary = summarize(setup, counter.last, counter.solves, 0.0, counter.errors)
     model_part = sum(c.error for c in plan.choices)
-    if any(m.singular_pressure for m in setup.block_cycles or (setup.cycle,)):
-        counter.notes.append(RESOLVED_STEPPING)
-        return {**{k: float("nan") for k in grid_error.KEYS}, grid_error.LIMIT_KEY: float("nan")}
     if not _estimated(filled):
         return {**grid_error.totals(summary, None, model_part), grid_error.LIMIT_KEY: float("nan")}
     companion, coarsest_case = _companions(setup, filled)

@@ -168,7 +168,7 @@ class _Loop:
         self.err_abs_m = self.err_abs_s = 0.0  # accumulated local depth errors (mm, L2)
         self.history: list = []  # implicit schemes: (N, φ_m, φ_s, p, φ_work)
         self.batch: list = []  # adaptive scheme: (wear m, wear s, work) at the last linear steps
-        self.watch = GrowthWatch(ceiling=not self.model.singular_pressure)
+        self.watch = GrowthWatch()
 
     def restore(self, st: dict) -> None:
         checkpoint.restore(self, st)
@@ -195,9 +195,7 @@ class _Loop:
             # a warm start can stall cg on a worn, conforming contact where a cold one converges (seen on the
             # tube in service: 7247 elements, a 400 µm scar): the cold start is the fallback, not the failure
             res = solve(op, gap, load, method=s.method, p0=None, tol=s.tolerance)
-        hint = ("; the resolved stroke's worn profiles have kinks its pressure cannot follow (README): use "
-                "model.stroke: mid_stroke" if self.model.singular_pressure else "")
-        checks.check_solution(res, op.grid.area, load, s.method, cycle, self.n, hint)
+        checks.check_solution(res, op.grid.area, load, s.method, cycle, self.n)
         p = res.pressure if s.coarse is None else refine_pressure(res.pressure, s.coarse, s.grid)
         checks.check_edges(p, s.band, s.grid, cycle, s.y_edges_free)
         return p, res

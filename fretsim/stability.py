@@ -162,14 +162,13 @@ class GrowthWatch:
     and a 1.5-fold growth are not made that way.  The state is a short list of numbers, kept in the checkpoint.
     """
 
-    def __init__(self, history=(), ceiling: bool = True):
+    def __init__(self, history=()):
         self.history = [float(a) for a in history][-(GROWTH_STEPS + 2):]
-        self.ceiling = ceiling  # off where the model's own pressure has element-scale peaks (a resolved stroke)
 
     def update(self, signed_amplitude: float) -> bool:
         self.history = (self.history + [float(signed_amplitude)])[-(GROWTH_STEPS + 2):]
         a = np.abs(self.history)
-        if self.ceiling and a[-1] > CEILING:
+        if a[-1] > CEILING:
             return True
         if len(a) < GROWTH_STEPS + 2 or a[-1] < NOISE_FLOOR:
             return False

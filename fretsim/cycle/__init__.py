@@ -46,7 +46,6 @@ class FrettingCycle(Protocol):
     linear: bool  # wear rates linear in the mid-stroke pressure: implicit steps are exact
     invariant: str  # the conserved quantity, for messages
     closed_form: bool  # the invariant is k·P·4δ·N itself (summed over a load history's blocks), not the work
-    singular_pressure: bool  # the model's own pressure has element-scale peaks: no ceiling on the checkerboard
     gap_model: str  # how the flat's wear enters the mid-stroke gap ("–": not at mid-stroke)
     needs_friction: bool  # the member resolves the shear traction: loading.friction_coefficient is required
     assumes_gross_slip: bool  # every point slides: refused where the contact partly sticks

@@ -40,7 +40,6 @@ class UniformCycle:
     linear: bool = True
     invariant: str = "k·P·4δ·N"
     closed_form = True  # its invariant is k·P·4δ·N itself (summed over a load history's blocks)
-    singular_pressure = False
     needs_friction = False
     assumes_gross_slip = True
 

@@ -63,7 +63,7 @@ def restore(loop, st: dict) -> None:
     loop.last_state = st  # a checkpoint is the state of the step written last: a retake goes back to it
     _restore_limits(loop, st)
     _restore_memory(loop, st)
-    loop.watch = GrowthWatch(np.atleast_1d(st.get("watch", [])), loop.watch.ceiling)
+    loop.watch = GrowthWatch(np.atleast_1d(st.get("watch", [])))
     loop.cyc = None  # rebuilt only if needed (a run resumed at its end)
     if "r_m" not in st:  # a checkpoint of format 1.2, which only had uniform slip: the rates follow from p
         cyc = loop.restored_cycle()

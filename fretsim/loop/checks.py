@@ -33,10 +33,10 @@ def check_resolution(res, grid, line_contact: bool) -> None:
                               + f"; at least {MIN_ELEMENTS_ACROSS_CONTACT} are needed", 0)
 
 
-def check_solution(res, op_area: float, load: float, method: str, cycle: int, n: int, hint: str = "") -> None:
+def check_solution(res, op_area: float, load: float, method: str, cycle: int, n: int) -> None:
     """A contact solve's result: converged, finite, non-negative and carrying the load."""
     if not res.success:
-        raise NumericalFailure(f"the contact solve did not converge at cycle {cycle}: {res.message}{hint}", n)
+        raise NumericalFailure(f"the contact solve did not converge at cycle {cycle}: {res.message}", n)
     if not np.isfinite(res.pressure).all():
         raise NumericalFailure(f"non-finite pressure from the {method} solver at cycle {cycle}", n)
     if (res.pressure < 0).any():

@@ -46,10 +46,6 @@ def spectrum(model, members: tuple) -> Spectrum:
     return combined(wear_spectrum(op, m.stiffness()) for m in distinct)
 
 
-RESOLVED_IMPLICIT = ("model.stroke resolved with implicit steps: they bias its depth beyond their own estimate "
-                     "(McColl 185 N 2D, 1 000 cycles: bdf2 +8.5 %, implicit +6.8 % against the run cycle by cycle); "
-                     "jumping.scheme adaptive, or linear below its stability limit, agree with it within 0.1 % at "
-                     "about 8× the cost (scripts/results/resolved_stepping.txt)")
 
 
 def build(case: Case, plan: Plan, grids, model, cycles, allow_unstable: bool) -> Stepping:
@@ -58,8 +54,6 @@ def build(case: Case, plan: Plan, grids, model, cycles, allow_unstable: bool) ->
     _check_model_growth(case, spec, plan)
     scheme = plan.add(choose_scheme(case))
     stepper = SCHEMES[scheme]
-    if stepper.implicit and any(m.singular_pressure for m in cycles.members):
-        plan.warnings.append(RESOLVED_IMPLICIT)
     solve_grid = model.solve_compliance.grid
     jump = plan.add(choose_linear_jump(case, scheme, limit, solve_grid))
     if not stepper.implicit:

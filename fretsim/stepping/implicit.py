@@ -122,12 +122,9 @@ def _accept(loop, cyc, d: int, partner: Optional[int], base: tuple, g: float, ha
     new_phi_w = base[2] + g * d * cyc.work
     h_m, h_s = new_phi_m - half * r_m, new_phi_s - half * r_s
     err_m, err_s, k_order = _local_errors(loop, partner, d, p_now, p_new, r_m, r_s, new_phi_m, new_phi_s, h_m, h_s)
-    # a non-linear cycle: what its linearised implicit solve got wrong, counted in both bodies' errors; it
-    # limits the step only where the model's own solution is smooth (a resolved stroke's kinks are not)
-    smooth = not loop.model.singular_pressure
+    # a non-linear cycle: what its linearised implicit solve got wrong, counted in both bodies' errors
     err_m, err_s = err_m + cyc.defect, err_s + cyc.defect
-    error = max(_rel_scalar(err_m if smooth else err_m - cyc.defect, _amax(h_m)),
-                _rel_scalar(err_s if smooth else err_s - cyc.defect, _amax(h_s))) / DEPTH_SHARE
+    error = max(_rel_scalar(err_m, _amax(h_m)), _rel_scalar(err_s, _amax(h_s))) / DEPTH_SHARE
     if error > 1.5 * tol and d > 1:
         loop.rejected += 1
         loop.jump = next_step(d, error, tol, k_order)
