@@ -215,8 +215,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
                     "auto", choices=SLIP_MODELS),
         "stroke": Key("choice", "the normal contact at mid-stroke only (mid_stroke, the paper) or at each increment "
                                 "of the cycle with the moving body where it is over the worn flat (resolved); "
-                                "auto: mid_stroke (the resolved stroke's worn profiles kink at the contact's turning edges: "
-                                "README), resolved only when asked; resolved needs loading.friction_coefficient",
+                                "auto: mid_stroke, resolved only when asked (it converges with the grid and the "
+                                "increments but costs about 40× the mid-stroke run: README); resolved needs "
+                                "loading.friction_coefficient",
                       "auto",
                       choices=STROKE_MODELS),
         "wear_law": Key("choice", "archard (dh = k·p·|ds|) or energy (dh = α·|q|·|ds|, Fouvry; needs "
