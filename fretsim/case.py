@@ -215,9 +215,10 @@ SCHEMA: dict[str, dict[str, Key]] = {
                     "auto", choices=SLIP_MODELS),
         "stroke": Key("choice", "the normal contact at mid-stroke only (mid_stroke, the paper) or at each increment "
                                 "of the cycle with the moving body where it is over the worn flat (resolved); "
-                                "auto: mid_stroke, resolved only when asked (it converges with the grid and the "
-                                "increments but costs about 40× the mid-stroke run: README); resolved needs "
-                                "loading.friction_coefficient",
+                                "auto: with model.slip coulomb on a line contact, resolved where 2D proxy runs "
+                                "show the mid-stroke depths or widths more than model.accuracy/3 away (it costs "
+                                "20-60× the mid-stroke run: README), else mid_stroke (uniform slip, partial slip, "
+                                "point contacts: said why); resolved needs loading.friction_coefficient",
                       "auto",
                       choices=STROKE_MODELS),
         "wear_law": Key("choice", "archard (dh = k·p·|ds|) or energy (dh = α·|q|·|ds|, Fouvry; needs "

@@ -169,6 +169,7 @@ class _Loop:
         self.history: list = []  # implicit schemes: (N, φ_m, φ_s, p, φ_work)
         self.batch: list = []  # adaptive scheme: (wear m, wear s, work) at the last linear steps
         self.watch = GrowthWatch()
+        self._summed = (None, None, None)  # (extra, compliance, their sum) of the last implicit solve
 
     def restore(self, st: dict) -> None:
         checkpoint.restore(self, st)
@@ -187,8 +188,10 @@ class _Loop:
             guess = None if guess is None else coarsen(guess, s.grid, s.coarse)
         else:
             op, gap = s.compliance, s.gap + seen
-        if extra is not None:
-            op = add(op, extra)
+        if extra is not None:  # one sum per step's term: a resolved cycle solves with it at every increment
+            if self._summed[0] is not extra or self._summed[1] is not op:
+                self._summed = (extra, op, add(op, extra))
+            op = self._summed[2]
         res = solve(op, gap, load, method=s.method, p0=guess, tol=s.tolerance)
         if not res.success and guess is not None and s.stepper.implicit:
             # (not for the explicit schemes: an adaptive jump's failed solve is its rejection, retried shorter)

@@ -146,13 +146,16 @@ def _hat_integral(t: np.ndarray) -> np.ndarray:
 
 
 def _sweep_shares(start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box"):
-    """For each flat element an element's travel reaches: that element (as an offset array) and its share.
+    """For each element of the moving body, the flat elements its travel reaches and their shares: (target,
+    share, inside), each (span, My, Mx) — target the flat element's column, inside whether it is on the grid and
+    the share is positive.
 
     ``box``: a point carries its amount along its travel and leaves it in the flat element it is over (the
     paper's stroke average, a point per element).  ``hat``: the flat is read between element centres (linear
     interpolation) and receives by the same weights, so what an element sees changes smoothly as it travels —
     needed where the pressure is solved at each position, or a travel across an element boundary switches the
-    whole flat by an element at once.
+    whole flat by an element at once.  All the offsets at once: a resolved cycle builds thousands of these on
+    small grids, where numpy's per-call cost, not the arithmetic, was the time.
     """
     nx = start.shape[1]
     lo = np.minimum(start, end) / dx
@@ -163,22 +166,18 @@ def _sweep_shares(start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "
     if kernel == "box":
         lo, hi = lo + 0.5, hi + 0.5  # in element widths from the left edge of the element's own cell
         first = np.floor(lo).astype(int)
-        span = int(np.max(np.ceil(hi) - first)) if start.size else 1
-        for m in range(max(span, 1)):
-            cell = first + m  # the flat element this piece lands in, relative to the moving element's own
-            overlap = np.clip(np.minimum(hi, cell + 1) - np.maximum(lo, cell), 0.0, None)
-            share = np.where(point, (m == 0), overlap / np.where(point, 1.0, length))
-            target = cols + cell
-            yield target, share, (target >= 0) & (target < nx) & (share > 0)
-        return
-    first = np.floor(lo).astype(int)  # the hats that can be non-zero over [lo, hi]: first .. ceil(hi)
-    span = int(np.max(np.ceil(hi) - first)) + 1 if start.size else 2
-    for m in range(max(span, 2)):
-        cell = first + m
+        span = max(int(np.max(np.ceil(hi) - first)) if start.size else 1, 1)
+        cell = first[None] + np.arange(span)[:, None, None]  # the flat element each piece lands in, relative
+        overlap = np.clip(np.minimum(hi, cell + 1) - np.maximum(lo, cell), 0.0, None)
+        share = np.where(point, (cell == first[None]), overlap / np.where(point, 1.0, length))
+    else:
+        first = np.floor(lo).astype(int)  # the hats that can be non-zero over [lo, hi]: first .. ceil(hi)
+        span = max(int(np.max(np.ceil(hi) - first)) + 1 if start.size else 2, 2)
+        cell = first[None] + np.arange(span)[:, None, None]
         share = np.where(point, np.clip(1.0 - np.abs(lo - cell), 0.0, None),
                          (_hat_integral(hi - cell) - _hat_integral(lo - cell)) / np.where(point, 1.0, length))
-        target = cols + cell
-        yield target, share, (target >= 0) & (target < nx) & (share > 0)
+    target = cols + cell
+    return target, share, (target >= 0) & (target < nx) & (share > 0)
 
 
 class Sweep:
@@ -187,23 +186,19 @@ class Sweep:
 
     def __init__(self, start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box"):
         self.shape = start.shape
-        self.shares = list(_sweep_shares(start, end, dx, kernel))
+        target, share, inside = _sweep_shares(start, end, dx, kernel)
+        ny, nx = self.shape
+        self._flat = (np.arange(ny)[:, None] * nx + target)[inside]  # the flat elements, flattened
+        self._share = share[inside]
+        self._from = np.broadcast_to(np.arange(ny * nx).reshape(ny, nx), target.shape)[inside]  # the moving's
 
     def deposit(self, amount: np.ndarray) -> np.ndarray:
-        ny, nx = self.shape
-        rows = np.arange(ny)[:, None] * nx
-        out = np.zeros(amount.size)
-        for target, share, inside in self.shares:
-            out += np.bincount((rows + target)[inside], weights=(amount * share)[inside], minlength=amount.size)
-        return out.reshape(ny, nx)
+        out = np.bincount(self._flat, weights=amount.ravel()[self._from] * self._share, minlength=amount.size)
+        return out.reshape(self.shape)
 
     def read(self, field: np.ndarray) -> np.ndarray:
-        ny, nx = field.shape
-        rows = np.arange(ny)[:, None]
-        out = np.zeros(field.shape)
-        for target, share, inside in self.shares:
-            out += np.where(inside, field[rows, np.clip(target, 0, nx - 1)] * share, 0.0)
-        return out
+        out = np.bincount(self._from, weights=field.ravel()[self._flat] * self._share, minlength=field.size)
+        return out.reshape(self.shape)
 
 
 def sweep_deposit(amount: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box") -> np.ndarray:

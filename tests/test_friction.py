@@ -379,7 +379,8 @@ def test_a_resolved_strokes_recorded_loop_spans_its_side_as_a_finely_stepped_res
 
 CASES = __import__("pathlib").Path(__file__).resolve().parents[1] / "cases"
 # the paper's grid: these runs compare stepping schemes, the explicit ones among them, on one grid
-COULOMB_2D = ["model.dimension=2d", "loading.friction_coefficient=0.9", "model.slip=coulomb", "grid.rule=paper"]
+COULOMB_2D = ["model.dimension=2d", "loading.friction_coefficient=0.9", "model.slip=coulomb", "model.stroke=mid_stroke",
+              "grid.rule=paper"]
 
 
 def _run(*overrides, case="mccoll_185N.yaml", output=None):
@@ -504,6 +505,32 @@ def test_auto_slip_chooses_from_the_regime_and_keeps_model_accuracy():
     for key in ("centre_wear_depth_stationary_um", "max_wear_depth_moving_um", "scar_width_stationary_mm",
                 "scar_width_moving_mm"):
         assert abs(a.summary[key] / b.summary[key] - 1) <= 0.04, key
+
+
+def test_auto_stroke_resolves_it_where_2d_proxies_show_mid_stroke_beyond_a_third_of_the_accuracy():
+    """model.stroke auto: McColl 185 N with μ 0.9 gets the resolved stroke (its 2D proxies put the mid-stroke depth
+    6.75 % away, more than 1 %/3), with the number in the reason; at model.accuracy 30 % the mid-stroke model is
+    kept and the difference, times the proxy margin, is the model's share of the error.  No proxy is run where the
+    answer is known: partial slip, the paper's uniform member, a point contact (said why)."""
+    from fretsim.api import check, load_case
+    from fretsim.plan.model import PROXY_MARGIN
+
+    def choice(*ov, case="mccoll_185N.yaml"):
+        return next(c for c in check(load_case(CASES / case, ["model.dimension=2d", *ov]))[2].choices
+                    if c.key == "model.stroke")
+    friction = ["loading.friction_coefficient=0.9", "model.slip=coulomb"]
+    tight = choice(*friction)
+    assert tight.value == "resolved" and "away from the mid-stroke model" in tight.reason
+    diff = float(tight.reason.split("% away")[0].split()[-1]) / 100
+    assert diff > 0.01 / PROXY_MARGIN
+    loose = choice(*friction, "model.accuracy=30 %")
+    assert loose.value == "mid_stroke" and loose.error == pytest.approx(diff * PROXY_MARGIN, rel=1e-3)
+    assert choice(*friction, "loading.stroke=0.4 um").value == "mid_stroke"  # partial slip: no proxy
+    assert "partial slip" in choice(*friction, "loading.stroke=0.4 um").reason
+    assert choice("loading.friction_coefficient=0.9", "model.slip=uniform").value == "mid_stroke"
+    ball = next(c for c in check(load_case(CASES / "ball_partial_slip.yaml", ["loading.stroke=20 um"]))[2].choices
+                if c.key == "model.stroke")
+    assert ball.value == "mid_stroke" and "no 2D model" in ball.reason
 
 
 def test_uniform_slip_below_the_transition_is_refused_with_the_reason():

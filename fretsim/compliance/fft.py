@@ -11,9 +11,12 @@ and the import is a third of a quick command's time.
 """
 from __future__ import annotations
 
+from functools import lru_cache
+
 import numpy as np
 
 
+@lru_cache(maxsize=512)  # every window of every operator asks again: the search cost a tenth of a resolved run
 def next_fast_len(n: int, real: bool) -> int:
     """scipy.fft.next_fast_len for its pocketfft backend, without importing it: the smallest m ≥ n whose prime
     factors are 2, 3 and 5 (real transforms) or 2, 3, 5, 7 and 11 (complex ones)."""

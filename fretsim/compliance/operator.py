@@ -119,16 +119,18 @@ class Convolution:
         """:meth:`restrict`, cached by the window's shape: a convolution's window depends on its size only,
         so the solver can work on the contact's neighbourhood and pay one symbol per size."""
         grid = window_grid(self.grid, rows, cols)
-        if len(self._parts) > 1 or self._parts[0][1] is not self:
-            out = None
-            for scale, part in self._parts:
-                w = part.window(rows, cols)
-                out = scaled(w, scale) if out is None else out.plus(w, scale)
-            return Convolution(grid, out.kernel, out.hat, _parts=None)
         shape = grid.shape
         cached = self._windows.get(shape)
         if cached is None:
-            cached = self._windows[shape] = self._like(grid, self._crop(grid))
+            if len(self._parts) > 1 or self._parts[0][1] is not self:
+                out = None
+                for scale, part in self._parts:
+                    w = part.window(rows, cols)
+                    out = scaled(w, scale) if out is None else out.plus(w, scale)
+                cached = Convolution(grid, out.kernel, out.hat, _parts=None)
+            else:
+                cached = self._like(grid, self._crop(grid))
+            self._windows[shape] = cached
         return Convolution(grid, cached.kernel, cached.hat) if cached.grid is not grid else cached
 
     def _crop(self, grid: Grid) -> np.ndarray:

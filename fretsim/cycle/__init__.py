@@ -62,6 +62,9 @@ class FrettingCycle(Protocol):
     def describe(self) -> str:
         """The cycle model in a few words, for a run's one-paragraph summary."""
 
+    def passes(self, implicit: bool) -> int:
+        """Cycles solved per step (an implicit step's corrections re-solve it): for the cost estimate."""
+
     def stiffness(self):
         """An operator W (gap growth per cycle per unit pressure, on the solve grid) whose spectrum bounds the
         member's: it sets the explicit stability limit and is what an implicit step folds into the compliance."""
@@ -86,6 +89,7 @@ FRICTION = "coulomb"  # the member that resolves friction: what auto takes where
 # model.stroke: where the normal contact is solved — once at mid-stroke (the paper), or at each increment
 STROKES: dict[str, bool] = {"mid_stroke": False, "resolved": True}
 MID_STROKE = "mid_stroke"
+RESOLVED = "resolved"  # what auto takes where a proxy shows the stroke's positions matter
 
 
 def build(slip: str, stroke: str, spec_fields: dict) -> FrettingCycle:

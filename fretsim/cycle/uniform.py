@@ -64,6 +64,9 @@ class UniformCycle:
     def stiffness(self):
         return self.wear_op
 
+    def passes(self, implicit: bool) -> int:
+        return 1
+
     def describe(self) -> str:
         return f"gap model {self.gap_model}"
 

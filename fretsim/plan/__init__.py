@@ -66,7 +66,7 @@ def prepare(case: Case, allow_unstable: bool = False, runs: Optional[SideRuns] =
             break
         refine = finer
     grid.warn_unresolved_stick(case, plan, regime.slip.value, regime.transition, contact, grids.grid)
-    cycles = cycle.build(case, plan, grids, operators, regime)
+    cycles = cycle.build(case, plan, grids, operators, regime, proxy_case, runs, plan_case)
     steps = stepping.build(case, plan, grids, operators, cycles, allow_unstable)
     return _setup(case, plan, grids, operators, regime, cycles, steps), _filled(case, grids, operators, cycles,
                                                                                  steps), plan

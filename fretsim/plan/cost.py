@@ -65,4 +65,5 @@ def estimate_cost(setup) -> tuple[int, float]:
     zero = np.zeros(setup.grid.shape)
     t = time.perf_counter()
     setup.cycle.solve(zero, zero, normal, None)
-    return solves, _seconds(setup, solves, time.perf_counter() - t)
+    passes = setup.cycle.passes(setup.stepper.implicit)
+    return solves, _seconds(setup, solves, time.perf_counter() - t) * passes

@@ -288,6 +288,25 @@ def _correction_proxies(case: Case, corrections: tuple, dimension: str, runs: Si
     return _worst(out, keys)
 
 
+def stroke_proxies(case: Case, runs: SideRuns, plan_case: PlanCase) -> tuple[float, str, str]:
+    """The largest relative difference of the reported quantities between the mid-stroke and the resolved stroke
+    in 2D proxy runs at half the automatic grid's x resolution, how to name it, and what the proxies were."""
+    cycles = case.loading.cycles
+    sizing, nx = _proxy_grid(case, _e_star(case))
+    dim, domain, elements = "2d", sizing.domain[:1], (nx,)
+    keys = WEAR_KEYS[:2] + ("centre_wear_depth_stationary_um",) + WEAR_KEYS[2:]
+    out = []
+    for stroke in ("mid_stroke", "resolved"):
+        proxy = case.with_choices(dimension=dim, corrections=_full_corrections(case, dim), snapshots=(cycles,),
+                                  domain=domain, elements=elements, coarse_element=None, linear_jump=None,
+                                  scheme="bdf2", preset=None, stroke_model=stroke, grid_error="none")
+        out.append(proxy_summary(proxy, lambda setup: f"model.stroke auto: a {dim.upper()} proxy run, stroke "
+                                 f"{stroke.replace('_', '-')} ({' × '.join(map(str, elements))} elements, {cycles} "
+                                 f"cycles)", runs, plan_case))
+    diff, what = _worst(out, keys)
+    return diff, what, f"{dim.upper()} proxy runs ({' × '.join(map(str, elements))} elements)"
+
+
 def _e_star(case: Case) -> float:
     return effective_modulus(case.moving.youngs_modulus, case.moving.poissons_ratio,
                              case.stationary.youngs_modulus, case.stationary.poissons_ratio)
