@@ -268,6 +268,35 @@ BLOCK_KEYS = ("normal_load", "stroke", "cycles", "friction_coefficient")
 MAX_BLOCKS = 10_000  # blocks after repeats: each restarts the stepping (a few solves)
 
 
+# what users call a key by another name: the key's full path (materials.<key>: a body's material key)
+_ALIASES = {"mu": "loading.friction_coefficient", "cof": "loading.friction_coefficient",
+            "friction": "loading.friction_coefficient", "coefficient_of_friction": "loading.friction_coefficient",
+            "k": "materials.wear_coefficient", "archard": "materials.wear_coefficient"}
+
+
+@functools.lru_cache(maxsize=1)
+def _key_homes() -> dict:
+    """Each key name of the schema's sections → its section ("" for a body's material)."""
+    homes: dict = {}
+    for section, keys in SCHEMA.items():
+        for key in keys:
+            homes.setdefault(key, "" if section == "material" else section)
+    return homes
+
+
+def _elsewhere(key: str, prefix: str) -> Optional[str]:
+    """Where a key given in the wrong section (``model.friction_coefficient``) or by another name (``mu``) lives,
+    as the hint to print; None if it is not one."""
+    name = key.strip().lower()
+    home = _ALIASES.get(name) or (f"{_key_homes()[name]}.{name}" if name in _key_homes() else None)
+    if home is None:
+        return None
+    section, _, leaf = home.rpartition(".")
+    if section in ("", "materials"):  # a body's material key
+        return leaf if prefix.startswith("materials.") else f"materials.moving.{leaf}' or 'materials.stationary.{leaf}"
+    return None if section == prefix else home
+
+
 class CaseError(InputError):
     """A case (or a sweep file, an option, an output) that cannot be run: every problem with its YAML path."""
 
@@ -557,7 +586,8 @@ class _Reader:
     def unknown(self, mapping: dict, keys, prefix: str) -> None:
         for k in mapping:
             if k not in keys:
-                hint = difflib.get_close_matches(str(k), keys, n=1, cutoff=0.6)
+                elsewhere = _elsewhere(str(k), prefix)
+                hint = [elsewhere] if elsewhere else difflib.get_close_matches(str(k), keys, n=1, cutoff=0.6)
                 name = excerpt(k) if not isinstance(k, str) else k[:40]
                 self.fail(f"{prefix}.{name}" if prefix else name, "unknown key" + (
                     f" (did you mean '{hint[0]}'?)" if hint else f"; allowed: {', '.join(sorted(keys))}"))

@@ -16,7 +16,8 @@ import re
 
 # dimension -> {unit spelling: factor to the internal unit}
 UNITS: dict[str, dict[str, float]] = {
-    "length": {"km": 1e6, "m": 1e3, "mm": 1.0, "um": 1e-3, "µm": 1e-3, "micron": 1e-3, "nm": 1e-6, "cm": 10.0},
+    "length": {"km": 1e6, "m": 1e3, "mm": 1.0, "um": 1e-3, "µm": 1e-3, "micron": 1e-3, "microns": 1e-3, "nm": 1e-6,
+               "cm": 10.0},
     "force": {"N": 1.0, "kN": 1e3, "MN": 1e6, "mN": 1e-3, "uN": 1e-6, "µN": 1e-6},
     "pressure": {"Pa": 1e-6, "kPa": 1e-3, "MPa": 1.0, "GPa": 1e3, "N/mm2": 1.0, "N/mm^2": 1.0},
     # Archard's k with the hardness in it: 1/MPa = mm²/N = mm³/(N·mm); tribologists quote the specific wear rate
@@ -34,14 +35,25 @@ INTERNAL = {"length": "mm", "force": "N", "pressure": "MPa", "wear_coefficient":
             "energy_wear_coefficient": "mm3/(N*mm)", "stiffness": "N/mm", "frequency": "Hz", "volume": "mm3"}
 
 _QUANTITY = re.compile(r"^\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?|[-+]?inf|nan)\s*(\S.*?)\s*$", re.IGNORECASE)
-_TYPESET = str.maketrans({"·": "*", "⋅": "*", "×": "*", "³": "3", "²": "2", "^": None})
+_TYPESET = str.maketrans({"·": "*", "⋅": "*", "×": "*", "³": "3", "²": "2", "^": None, "μ": "µ", "⁻": "-",
+                          "¹": "1"})  # (μ: the Greek letter, typed for the micro sign µ)
 
 
 def _plain_unit(unit: str) -> str:
-    """A unit as typed or typeset — mm³/(N·m), mm^3/(N m) — in the tables' spelling, mm3/(N*m): a space between
-    two symbols is a product, any other is dropped."""
+    """A unit as typed or typeset — mm³/(N·m), mm^3/(N m), mm3/N/m, mm3 N-1 m-1 — in the tables' spelling,
+    mm3/(N*m): a space between two symbols is a product, any other is dropped; a chain of divisions, or
+    symbols to the power −1, is one denominator."""
     unit = re.sub(r"(?<=[\w)])\s+(?=[\w(])", "*", unit.strip())
-    return re.sub(r"\s+", "", unit).translate(_TYPESET)
+    unit = re.sub(r"\s+", "", unit).translate(_TYPESET)
+    if "(" not in unit:
+        parts = unit.split("*")
+        below = [t[:-2] for t in parts if t.endswith("-1") and len(t) > 2]
+        if below and len(below) < len(parts):
+            unit = "*".join(t for t in parts if not (t.endswith("-1") and len(t) > 2)) + "/" + "*".join(below)
+        num, *den = unit.split("/")
+        if len(den) == 1 and "*" in den[0] or len(den) > 1:
+            unit = f"{num}/({'*'.join(den)})"
+    return unit
 
 
 class UnitError(ValueError):

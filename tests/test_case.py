@@ -3,6 +3,8 @@ import pytest
 
 from fretsim.case import CaseError, load_case, parse_case
 
+ROOT = __import__("pathlib").Path(__file__).resolve().parents[1]
+
 CONTRACT = """
 name: mccoll-185N
 geometry:  {type: cylinder_on_flat, radius: 6 mm, length: 10 mm}
@@ -110,11 +112,31 @@ def test_missing_file_is_a_case_error(tmp_path):
 
 
 @pytest.mark.parametrize("text", ["2e-5 mm3/(N*m)", "2e-5 mm³/(N·m)", "2e-5 mm^3/(N m)", "2e-8 mm3/(N*mm)",
-                                  "2e-14 1/Pa", "2e-14 m2/N", "2e-5 mm3/Nm"])
+                                  "2e-14 1/Pa", "2e-14 m2/N", "2e-5 mm3/Nm", "2e-5 mm3/N/m", "2e-5 mm3 N-1 m-1",
+                                  "2e-5 mm³·N⁻¹·m⁻¹", "2e-8 mm3/N/mm"])
 def test_the_specific_wear_rate_tribologists_quote_is_read_in_any_spelling(text):
     """mm³/(N·m) is volume per load and sliding distance in metres: a thousandth of 1/MPa (= mm³/(N·mm))."""
     from fretsim.units import parse_quantity
     assert parse_quantity(text, "wear_coefficient") == pytest.approx(2e-8, rel=1e-12)
+
+
+@pytest.mark.parametrize("text", ["25 um", "25 µm", "25 μm", "25 micron", "25 microns", "0.025 mm"])
+def test_a_micrometre_is_read_as_typed_micro_sign_greek_mu_or_microns(text):
+    """µ (the micro sign) and μ (the Greek letter) look alike and keyboards give either."""
+    from fretsim.units import parse_quantity
+    assert parse_quantity(text, "length") == pytest.approx(0.025, rel=1e-12)
+
+
+@pytest.mark.parametrize("key, hint", [("model.friction_coefficient=0.9", "loading.friction_coefficient"),
+                                       ("model.mu=0.9", "loading.friction_coefficient"),
+                                       ("materials.moving.friction_coefficient=0.9", "loading.friction_coefficient"),
+                                       ("model.cycles=5", "loading.cycles"),
+                                       ("loading.wear_coefficient=2e-8 1/MPa", "materials.moving.wear_coefficient"),
+                                       ("materials.moving.k=2e-8 1/MPa", "'wear_coefficient'")])
+def test_a_key_in_the_wrong_section_or_by_another_name_is_pointed_to_where_it_lives(key, hint):
+    with pytest.raises(CaseError) as err:
+        load_case(ROOT / "cases" / "mccoll_185N.yaml", [key])
+    assert f"did you mean '{hint}" in str(err.value) or f"did you mean {hint}" in str(err.value), str(err.value)
 
 
 def test_a_quoted_number_without_a_unit_is_called_that():
