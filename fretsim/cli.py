@@ -710,11 +710,18 @@ def _write_and_list(write, what: str) -> None:
 @click.option("--debug", is_flag=True, help="Show tracebacks.")
 @_boundary
 def export(results_file: Path, csv_dir: Path, debug: bool) -> None:
-    """Write RESULTS_FILE as CSV files for spreadsheets (units in the column names)."""
+    """Write RESULTS_FILE as CSV files for spreadsheets (units in the column names); a sweep's directory writes
+    each of its points' into a directory of the point's name (its table.csv already has one row per point)."""
     from fretsim.export import export_csv
 
-    res = _read_results(results_file, "export")
-    _write_and_list(lambda: export_csv(res, csv_dir), str(csv_dir))
+    points = _points_of_sweeps((results_file,))
+    if points == (results_file,):
+        res = _read_results(results_file, "export")
+        _write_and_list(lambda: export_csv(res, csv_dir), str(csv_dir))
+        return
+    for point in points:  # each read (and checked) before its files are written, as for one file
+        res = _read_results(point, "export")
+        _write_and_list(lambda: export_csv(res, csv_dir / point.stem), str(csv_dir / point.stem))
 
 
 def _not_an_input(output: Path, inputs: dict) -> None:

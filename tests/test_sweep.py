@@ -270,6 +270,17 @@ def test_summary_of_a_sweep_directory_is_the_summary_of_its_points_in_table_orde
         pytest.approx([float(p["centre_wear_depth_stationary_um"]) for p in points], rel=1e-12)
 
 
+def test_export_of_a_sweep_directory_writes_each_points_csvs_in_a_directory_of_its_name(local_sweep, tmp_path):
+    _, out, _ = local_sweep
+    r = CliRunner().invoke(main, ["export", str(out), "--csv", str(tmp_path / "csv")])
+    assert r.exit_code == 0, r.output
+    for p in table(out):
+        with open(tmp_path / "csv" / p["point"] / "summary.csv") as fh:
+            value = {row["quantity"]: row["value"] for row in csv.DictReader(fh)}
+        assert float(value["centre_wear_depth_stationary_um"]) == \
+            pytest.approx(float(p["centre_wear_depth_stationary_um"]), rel=1e-12)
+
+
 def test_the_same_sweep_on_a_dask_cluster_gives_the_same_table_bit_for_bit(local_sweep):
     distributed = pytest.importorskip("distributed")
     tmp, reference, _ = local_sweep
