@@ -311,7 +311,8 @@ class CaseError(InputError):
         if n == 1:
             path, msg = self.problems[0]
             return f"{self.source}: {path + ': ' if path else ''}{msg}"
-        head = f"{self.source}: the {self.what} has {n} problems"
+        verb = "have" if self.what.endswith("s") else "has"  # "the measurements have", "the case has"
+        head = f"{self.source}: the {self.what} {verb} {n} problems"
         return head + ":\n" + "\n".join(f"  - {path}: {msg}" if path else f"  - {msg}" for path, msg in self.problems)
 
 

@@ -772,13 +772,15 @@ def fit(case_file: Path, measured_file: Path, fit_keys: tuple, overrides: tuple,
         click.echo(f"note: {note}", err=True)
     click.echo(f"fitting {', '.join(fit_keys or DEFAULT_FIT)} to {measured.values.size} measured value(s) of "
                f"{measured_file}", err=True)
+    live = sys.stderr.isatty()  # a counter rewritten in place; off a terminal (a sweep's log) the total only
     try:
         res = fit_case(text, str(case_file), measured, fit_keys or DEFAULT_FIT, overrides,
-                       progress=lambda n: click.echo(f"\r  {n} runs", nl=False, err=True),
-                       note=lambda text: click.echo(f"note: {text}", err=True))
+                       progress=(lambda n: click.echo(f"\r  {n} runs", nl=False, err=True)) if live else None,
+                       note=lambda text: click.echo(("\n" if live else "") + f"note: {text}", err=True))
     except RuntimeError as exc:
         raise Fail(f"the fit stopped: {exc}", 3) from None
-    click.echo("", err=True)
+    if live:
+        click.echo("", err=True)
     for k, v0, v, lo, hi, kind in zip(res.keys, res.start, res.values, res.low, res.high, res.kinds):
         def short(x):
             return f"{x:.4g}" + ("" if kind == "number" else f" {INTERNAL[kind]}")

@@ -151,3 +151,9 @@ def test_a_stroke_written_as_the_figures_print_it_is_its_amplitude():
     a = load_case(CASES / "mccoll_185N.yaml", ["loading.stroke=±25 um"]).loading.peak_stroke
     b = load_case(CASES / "mccoll_185N.yaml", ["loading.stroke=+/-25 um"]).loading.peak_stroke
     assert a == b == load_case(CASES / "mccoll_185N.yaml").loading.peak_stroke
+
+
+def test_a_plural_subject_takes_have_in_the_problem_count():
+    many = [("a", "x"), ("b", "y")]
+    assert "the measurements have 2 problems" in str(CaseError("m.csv", many, "measurements"))
+    assert "the case has 2 problems" in str(CaseError("c.yaml", many))

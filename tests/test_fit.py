@@ -172,6 +172,7 @@ def test_the_fitted_case_keeps_the_set_overrides_and_reruns_to_the_fitted_depth(
                                   "--set", f"materials.moving.wear_coefficient={K_MOVING} 1/MPa",
                                   "--fit", "materials.stationary.wear_coefficient", "-o", str(out)])
     assert r.exit_code == 0, r.output
+    assert "\r" not in r.output and re.search(r"^\d+ runs, ", r.output, re.M)  # off a terminal: the total only
     fitted = load_case(out)
     assert fitted.dimension == "2d"
     assert fitted.moving.wear_coefficient == K_MOVING
