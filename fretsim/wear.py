@@ -145,7 +145,7 @@ def _hat_integral(t: np.ndarray) -> np.ndarray:
     return np.where(t < 0, 0.5 * (t + 1.0) ** 2, 1.0 - 0.5 * (1.0 - t) ** 2)
 
 
-def _sweep_shares(start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box"):
+def _sweep_shares(start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box", nx: int = 0, c0: int = 0):
     """For each element of the moving body, the flat elements its travel reaches and their shares: (target,
     share, inside), each (span, My, Mx) — target the flat element's column, inside whether it is on the grid and
     the share is positive.
@@ -155,14 +155,15 @@ def _sweep_shares(start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "
     interpolation) and receives by the same weights, so what an element sees changes smoothly as it travels —
     needed where the pressure is solved at each position, or a travel across an element boundary switches the
     whole flat by an element at once.  All the offsets at once: a resolved cycle builds thousands of these on
-    small grids, where numpy's per-call cost, not the arithmetic, was the time.
+    small grids, where numpy's per-call cost, not the arithmetic, was the time.  ``start`` and ``end`` may be the
+    columns from ``c0`` of a grid ``nx`` wide.
     """
-    nx = start.shape[1]
+    nx = nx or start.shape[1]
     lo = np.minimum(start, end) / dx
     hi = np.maximum(start, end) / dx
     length = hi - lo
     point = length < 1e-9
-    cols = np.arange(nx)[None, :]
+    cols = np.arange(c0, c0 + start.shape[1])[None, :]
     if kernel == "box":
         lo, hi = lo + 0.5, hi + 0.5  # in element widths from the left edge of the element's own cell
         first = np.floor(lo).astype(int)
@@ -184,13 +185,16 @@ class Sweep:
     """The shares of one travel (each element j of the moving body from x_j + start[j] to x_j + end[j], mm),
     computed once for the several fields deposited and read along it (:func:`sweep_deposit`, :func:`sweep_read`)."""
 
-    def __init__(self, start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box"):
+    def __init__(self, start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box", cols: slice = slice(None)):
+        """``cols``: only these columns of the moving body travel anything (the rest deposit and read nothing)."""
         self.shape = start.shape
-        target, share, inside = _sweep_shares(start, end, dx, kernel)
         ny, nx = self.shape
+        c0, c1, _ = cols.indices(nx)
+        target, share, inside = _sweep_shares(start[:, c0:c1], end[:, c0:c1], dx, kernel, nx, c0)
         self._flat = (np.arange(ny)[:, None] * nx + target)[inside]  # the flat elements, flattened
         self._share = share[inside]
-        self._from = np.broadcast_to(np.arange(ny * nx).reshape(ny, nx), target.shape)[inside]  # the moving's
+        moving = np.arange(ny * nx).reshape(ny, nx)[:, c0:c1]
+        self._from = np.broadcast_to(moving, target.shape)[inside]  # the moving body's
 
     def deposit(self, amount: np.ndarray) -> np.ndarray:
         out = np.bincount(self._flat, weights=amount.ravel()[self._from] * self._share, minlength=amount.size)
@@ -217,6 +221,12 @@ def sweep_read(field: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float,
     """The flat's ``field`` as each element j of the moving body sees it over its travel from x_j + start[j] to
     x_j + end[j]: the travel-weighted average, 0 beyond the grid (unworn).  The adjoint of :func:`sweep_deposit`
     (same shares), which keeps the resolved cycle's wear modes decaying: a read that is not the deposit's
-    adjoint (interpolation at the travel's midpoint, say) lets short wear modes of the moving body grow."""
-    return Sweep(start, end, dx, kernel).read(field)
+    adjoint (interpolation at the travel's midpoint, say) lets short wear modes of the moving body grow.
+    Only the columns whose travel reaches the field's non-zero part are read (the rest read 0 exactly)."""
+    nx = field.shape[1]
+    worn = np.flatnonzero(field.any(axis=0))
+    if worn.size == 0:
+        return np.zeros(field.shape)
+    reach = int(np.ceil(max(np.abs(start).max(), np.abs(end).max()) / dx)) + 2
+    return Sweep(start, end, dx, kernel, slice(max(worn[0] - reach, 0), min(worn[-1] + reach + 1, nx))).read(field)
 

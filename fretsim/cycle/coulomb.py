@@ -209,10 +209,8 @@ class CoulombCycle:
                 (p, res), (q_new, ds, stuck, its) = fixed, self._tangential(q, fixed[0], du)
                 tally.iterations += its
             if counted:
-                sweep = tally.add(self, p, q_new, s, ds, abs(du) / (4.0 * self.stroke))
+                tally.add(self, p, q_new, s, ds, abs(du) / (4.0 * self.stroke))
                 tally.loop(u1, q_new)
-                if corrected and self.resolved:
-                    visits[-1] = (p, sweep)
             if k == mid:
                 p_mid, res_mid, travel_mid = p, res, (s, s + ds)
             if k == end:
@@ -334,10 +332,11 @@ class _Tally:
         self.loop_u.append(u)
         self.loop_q.append(float(q.sum()) * self.area)
 
-    def add(self, member: "CoulombCycle", p, q_new, s, ds, share: float) -> Sweep:
+    def add(self, member: "CoulombCycle", p, q_new, s, ds, share: float) -> None:
         """One counted increment, ``share`` of the cycle's rig travel: the moving body wears at its own points, the
         flat where each point travelled; the flat's pressure is averaged over the rig's travel."""
-        sweep = Sweep(s, s + ds, member.grid.dx, member.kernel)  # one travel, three fields along it
+        on = np.flatnonzero((p > 0).any(axis=0))  # the columns that carry anything (p = 0 elsewhere)
+        sweep = Sweep(s, s + ds, member.grid.dx, member.kernel, slice(on[0], on[-1] + 1) if on.size else slice(0, 0))
         amount = member.law.amount(p, q_new, ds)
         self.rate_m += member.k_moving * amount
         self.rate_s += member.k_stationary * sweep.deposit(amount)
@@ -348,7 +347,6 @@ class _Tally:
         self.energy += float((np.abs(q_new) * np.abs(ds)).sum()) * self.area
         self.work += float(amount.sum()) * self.area
         self.shear = np.maximum(self.shear, np.abs(q_new))
-        return sweep
 
     def cycle(self, member: "CoulombCycle", p_mid, res_mid, stick_end, defect: float, mismatch) -> Cycle:
         """The cycle these increments make, with the memory its next cycle's implicit step needs."""
@@ -369,21 +367,28 @@ class _Tally:
 
 def _mismatches(visits: list, tally: _Tally, step: float, w_lin, dx: float, kernel: str) -> list:
     """For a resolved step's next pass, each increment's own mismatch: the gap growth its position found against
-    the anticipated (a counted increment's travel read as it wore: its Sweep kept)."""
-    return [step * (tally.rate_m + (v[1].read(tally.rate_s) if len(v) == 2 else
-                                    sweep_read(tally.rate_s, v[1], v[2], dx, kernel)) - w_lin(v[0])) for v in visits]
+    the anticipated."""
+    return [step * (tally.rate_m + sweep_read(tally.rate_s, a, b, dx, kernel) - w_lin(pk)) for pk, a, b in visits]
 
 
 def _nearest_in_contact(values: np.ndarray, on: np.ndarray) -> np.ndarray:
-    """``values`` outside the contact ``on`` replaced, row by row, by the nearest value inside it along x."""
+    """``values`` outside the contact ``on`` replaced, row by row, by the nearest value inside it along x (the left
+    one on a tie); rows without contact kept.  All rows at once (a 3D grid's rows, one by one, were a twentieth of
+    a resolved run)."""
+    ny, nx = values.shape
+    idx = np.broadcast_to(np.arange(nx), (ny, nx))
+    big = nx
+    right = np.minimum.accumulate(np.where(on, idx, big)[:, ::-1], axis=1)[:, ::-1]  # first in contact at or after
+    last = np.where(on, idx, -1).max(axis=1, keepdims=True)
+    right = np.where(right == big, last, right)
+    before = np.maximum.accumulate(np.where(on, idx, -1), axis=1)  # last in contact at or before
+    left = np.concatenate([np.full((ny, 1), -1), before[:, :-1]], axis=1)  # ... strictly before
+    first = np.where(on, idx, big).min(axis=1, keepdims=True)
+    left = np.where(left < 0, first, left)
+    pick = np.where(idx - left <= right - idx, left, right)
+    rows = on.any(axis=1)
     out = values.copy()
-    nx = values.shape[1]
-    idx = np.arange(nx)
-    for r in np.flatnonzero(on.any(axis=1)):
-        inside = np.flatnonzero(on[r])
-        at = np.searchsorted(inside, idx)
-        right, left = inside[np.minimum(at, inside.size - 1)], inside[np.maximum(at - 1, 0)]
-        out[r] = values[r, np.where(idx - left <= right - idx, left, right)]
+    out[rows] = np.take_along_axis(values, np.clip(pick, 0, nx - 1), axis=1)[rows]
     return out
 
 
