@@ -20,7 +20,7 @@ import matplotlib
 matplotlib.use("Agg")
 import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
-from matplotlib.ticker import FuncFormatter, MaxNLocator, ScalarFormatter  # noqa: E402
+from matplotlib.ticker import FuncFormatter, MaxNLocator  # noqa: E402
 
 from fretsim.measures import centre_line  # noqa: E402
 from fretsim.quantities import SUMMARY  # noqa: E402
@@ -247,20 +247,156 @@ def run_status(res: Results) -> str:
     return f"{said.get(res.status, f'status {res.status!r}')} {where}"
 
 
+LABEL_WIDTH = 48  # characters of a legend line at fontsize 7 that keep a legend within an overlay's panel
+LABEL_KEYS = 3  # differing values a label names; the rest are counted ("+2 more")
+VALUE_WIDTH = 24  # characters of a value in a label (a load history's blocks are a long list)
+
+
+def run_labels(results: list) -> list[str]:
+    """A legend label per run, saying what tells it apart from the others (a file name alone said nothing):
+    the ``--set`` values that differ (as written where every run set the key, else each run's value from its
+    filled case); else the case's own values that differ (another case file or an edited one; the automatic
+    choices they lead to are left out); else the automatic choices that differ.  The case's name where the cases
+    differ or nothing else does, the file's name in brackets, and how far a run that did not complete got
+    (:func:`run_status`); at most LABEL_KEYS values, in lines of at most LABEL_WIDTH characters."""
+    return [_fill(chunks) for chunks in _label_chunks(results)]
+
+
+def _label_chunks(results: list) -> list[list]:
+    """Each run's label as (separator, text) pieces, for :func:`_fill` to break into lines between them."""
+    cases = [_case_values(r) for r in results]
+    asked = [_asked(r) for r in results]
+    names = [str(r.attrs.get("case_name", "")) for r in results]
+    automatic = {str(k) for r in results for k, _, why in r.choices if not str(why).startswith("given")}
+
+    def canonical(i, k):  # the filled case's value (one spelling: 25 um and 0.025 mm are the same stroke)
+        return cases[i].get(k, asked[i].get(k))
+
+    keys = list(dict.fromkeys([k for a in asked for k in a] + [k for c in cases for k in c]))
+    differ = [k for k in keys if len({canonical(i, k) for i in range(len(results))}) > 1]
+    given = [k for k in differ if any(k in a for a in asked)]
+    own = [k for k in differ if k not in given and k not in automatic]
+    named = len(set(names)) > 1
+    shown = given if named else (given + own or [k for k in differ if k not in given])
+    short = _short_keys(shown)
+    # as written where every run set it; else each run's filled value, in one spelling (not 10 um beside 0.025 mm)
+    written = {k: all(k in a for a in asked) for k in shown}
+    out = []
+    for i, res in enumerate(results):
+        chunks = [(", ", names[i])] if named or not shown else []
+        for k in shown[:LABEL_KEYS]:
+            value = asked[i][k] if written[k] else canonical(i, k) or "–"
+            chunks.append((", ", f"{short[k]}={_excerpt(value, VALUE_WIDTH)}"))
+        if len(shown) > LABEL_KEYS:
+            chunks.append((", ", f"+{len(shown) - LABEL_KEYS} more"))
+        status = run_status(res)
+        stem = _excerpt(Path(res.path).stem, VALUE_WIDTH)
+        chunks += [(" ", f"({stem}" + ("," if status else ")"))] + ([(" ", f"{status})")] if status else [])
+        out.append(chunks)
+    return out
+
+
+def _fill(chunks: list, width: int = LABEL_WIDTH) -> str:
+    """Join (separator, text) pieces into lines of at most ``width`` characters, breaking only between pieces (a
+    value, a number and its unit, a run's status stay whole: a piece longer than ``width`` makes a line of its
+    own)."""
+    lines: list = []
+    for i, (sep, text) in enumerate(chunks):
+        length = len(lines[-1]) + len(sep) + len(text) if lines else 0
+        after = chunks[i + 1] if i + 1 < len(chunks) else ("", "")
+        ends = "," in after[0] and length + len(after[0]) + len(after[1]) > width  # the line would end ", "
+        if lines and length + ends <= width:
+            lines[-1] += sep + text
+        else:
+            if lines:
+                lines[-1] += sep.rstrip()  # a comma stays at the end of its line
+            lines.append(text)
+    return "\n".join(lines)
+
+
+def _case_values(res: Results) -> dict:
+    """The filled case stored in the file as dotted key → value as text (its name and published values aside)."""
+    from fretsim.yamlread import YamlProblem, loads
+    try:
+        case = loads(res.case_yaml) or {}
+    except YamlProblem:
+        return {}
+    out: dict = {}
+
+    def walk(node, prefix):
+        for k, v in node.items():
+            if isinstance(v, dict):
+                walk(v, f"{prefix}{k}.")
+            else:
+                out[f"{prefix}{k}"] = _as_text(v)
+    if isinstance(case, dict):
+        walk({k: v for k, v in case.items() if k not in ("name", "expected")}, "")
+    return out
+
+
+def _asked(res: Results) -> dict:
+    """The run's --set overrides, key → value as written (the last of a key wins, as when the run read them)."""
+    out = {}
+    for item in res.overrides:
+        key, sep, value = str(item).partition("=")
+        if sep:
+            out[key.strip()] = value.strip()
+    return out
+
+
+def _as_text(value) -> str:
+    if isinstance(value, dict):
+        return "{" + ", ".join(f"{k}: {_as_text(v)}" for k, v in value.items()) + "}"
+    if isinstance(value, (list, tuple)):
+        return "[" + ", ".join(_as_text(v) for v in value) + "]"
+    if isinstance(value, bool):
+        return str(value).lower()
+    if isinstance(value, float):
+        return f"{value:g}"
+    return _tidy(str(value))
+
+
+def _tidy(text: str) -> str:
+    """A number as it reads: 185.0 N as 185 N, 1.0e-05 as 1e-05."""
+    number, sep, unit = text.partition(" ")
+    try:
+        return f"{float(number):g}{sep}{unit}" if number.strip() else text
+    except ValueError:
+        return text
+
+
+def _excerpt(text: str, width: int) -> str:
+    return text if len(text) <= width else text[:width - 1] + "…"
+
+
+def _short_keys(keys: list) -> dict:
+    """Each dotted key by its shortest tail that no other of ``keys`` ends with (normal_load;
+    moving.wear_coefficient beside stationary.wear_coefficient; loading.stroke beside model.stroke)."""
+    out = {}
+    for k in keys:
+        parts = k.split(".")
+        for n in range(1, len(parts) + 1):
+            tail = ".".join(parts[-n:])
+            if not any(o != k and (o == tail or o.endswith("." + tail)) for o in keys):
+                break
+        out[k] = tail
+    return out
+
+
 def overlay(results: list, expected: bool = False):
     """Several runs on one figure, as the paper compares RT with 90 °C and runs with and without jumping: the
     final worn profiles of both bodies across the contact, and each body's maximum depth against cycles; with
     ``expected``, each case's published values (experiment, FEA, the paper) as markers."""
     fig, axes = plt.subplots(2, 2, figsize=(12, 8), squeeze=False)
     shown = set()  # published values are the case's: drawn once per case, in black
-    for k, res in enumerate(results):
-        status = run_status(res)
-        label = f"{res.attrs.get('case_name', '')} ({Path(res.path).stem}{', ' + status if status else ''})"
+    for k, (res, chunks) in enumerate(zip(results, _label_chunks(results))):
+        label = _fill(chunks)
         colour = f"C{k % 10}"
         last = len(res.fields["cycle"]) - 1
+        at = _fill(chunks + [(", ", _cycles_label(res.fields["cycle"][last]))])
         for col, body in enumerate(("stationary", "moving")):
             row = centre_line(res.fields[f"wear_depth_{body}"][last])
-            axes[0, col].plot(res.x, -row, color=colour, label=f"{label}, {_cycles_label(res.fields['cycle'][last])}")
+            axes[0, col].plot(res.x, -row, color=colour, label=at)
             axes[1, col].plot(res.history["cycle"], res.history[f"max_wear_depth_{body}"], color=colour,
                               marker=".", ms=3, label=label)
         name = res.attrs.get("case_name", "")
@@ -288,8 +424,10 @@ def overlay(results: list, expected: bool = False):
     for ax in axes.ravel():
         ax.grid(alpha=0.3)
         ax.legend(fontsize=7)
-    fig.suptitle(f"{len(results)} run(s) overlaid" + ("; markers: published values (case `expected:`)"
-                                                        if expected else ""), fontsize=9)
+    names = {str(r.attrs.get("case_name", "")) for r in results}
+    of = f" of {names.pop()}" if len(names) == 1 else ""  # one case: its name here, what differs in the legends
+    fig.suptitle(f"{len(results)} run{'s' if len(results) > 1 else ''}{of} overlaid"
+                 + ("; markers: published values (case `expected:`)" if expected else ""), fontsize=9)
     fig.subplots_adjust(left=0.07, right=0.98, bottom=0.07, top=0.93, hspace=0.32, wspace=0.22)
     return fig
 
@@ -700,62 +838,186 @@ def band_data(table: SweepTable, key: str = "max_wear_depth_moving") -> dict:
     return out
 
 
+def uncertainty_figures(table: SweepTable) -> dict:
+    """A sampled sweep's figures, name → matplotlib Figure (tests check what is drawn; :func:`uncertainty_bands`
+    saves them): the depth band, and where samples reached a wear limit, the histogram of the time to it."""
+    out = {"uncertainty_depth_band": _depth_band(table)}
+    histogram = _time_to_limit(table)
+    if histogram is not None:
+        out["uncertainty_time_to_limit"] = histogram
+    return out
+
+
 def uncertainty_bands(table: SweepTable, outdir: Path, fmt: str = "png", dpi: int = 150) -> list[Path]:
-    """A sampled sweep: the deepest wear against cycles as a P10-P90 band with its median (one per group of the
-    listed axes), and a histogram of the cycles (and, with loading.frequency, years) to the wear limit."""
+    """Save :func:`uncertainty_figures` as OUTDIR/NAME.FMT."""
     paths = []
+    for name, fig in uncertainty_figures(table).items():
+        path = Path(outdir) / f"{name}.{fmt}"
+        try:
+            _savefig(fig, path, dpi)
+        finally:
+            plt.close(fig)
+        paths.append(path)
+    return paths
+
+
+def _group_label(table: SweepTable, group: tuple) -> str:
+    return ", ".join(f"{k.split('.')[-1]} = {v}" for k, v in zip(table.groups, group)) or "all samples"
+
+
+def _depth_band(table: SweepTable):
+    """The deepest wear against cycles: the P10–P90 band and the P50 over the samples, per group of the listed
+    axes, each named by its percentiles."""
     bands = band_data(table, "max_wear_depth_moving")
     fig, ax = plt.subplots(figsize=(6.5, 4.2))
     for i, (group, b) in enumerate(bands.items()):
-        label = ", ".join(f"{k.split('.')[-1]} = {v}" for k, v in zip(table.groups, group)) or "all samples"
-        line, = ax.plot(b["cycles"], b["p50"], ls=STYLES[i % len(STYLES)], label=f"{label}: median")
+        prefix = f"{_group_label(table, group)}: " if table.groups else ""
+        line, = ax.plot(b["cycles"], b["p50"], ls=STYLES[i % len(STYLES)], label=f"{prefix}P50 (median)")
         ax.fill_between(b["cycles"], b["p10"], b["p90"], color=line.get_color(), alpha=0.25,
-                        label=f"{label}: P10-P90 ({b['points']} samples)")
+                        label=f"{prefix}P10–P90 of {b['points']} samples")
     ax.set_xlabel("cycles N (–)")
+    ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: cycles_tick(v)))
     ax.set_ylabel("maximum wear depth of the moving body (µm)")
     ax.grid(alpha=0.3)
     ax.legend(fontsize=7)
     ax.set_title(f"{Path(table.path).name}: depth band over the samples (a sample at its limit held there)",
                  fontsize=9)
     fig.tight_layout()
-    path = outdir / f"uncertainty_depth_band.{fmt}"
-    _savefig(fig, path, dpi)
-    plt.close(fig)
-    paths.append(path)
-    reached = [r for r in table.rows if r.get("status") == "complete" and r.get("limit_reached")]
-    if reached:
-        years = all(r.get("time_to_limit_h") not in (None, "", "nan") for r in reached)
-        fig, ax = plt.subplots(figsize=(6.5, 4.2))
-        groups: dict = {}
-        for r in reached:
-            groups.setdefault(tuple(r.get(k) for k in table.groups), []).append(
-                float(r["time_to_limit_h"]) / 8766.0 if years else float(r["cycles_to_limit"]))
-        not_reached = [r for r in table.rows if r.get("status") == "complete" and not r.get("limit_reached")]
-        for i, (group, vals) in enumerate(groups.items()):
-            label = ", ".join(f"{k.split('.')[-1]} = {v}" for k, v in zip(table.groups, group)) or "all samples"
-            beyond = sum(1 for r in not_reached if tuple(r.get(k) for k in table.groups) == group)
-            # the samples that did not reach the limit lie beyond every one that did (percentiles.csv does so too)
-            p10, p50, p90 = np.quantile(np.r_[np.sort(vals), np.full(beyond, np.inf)], (0.1, 0.5, 0.9),
-                                        method="inverted_cdf")
-            ax.hist(vals, bins=np.logspace(np.log10(min(vals)), np.log10(max(vals)), 25) if min(vals) > 0 else 25,
-                    alpha=0.5, label=f"{label}: P10 {p10:.3g}, P50 {p50:.3g}, P90 {p90:.3g}")
-        if all(min(v) > 0 for v in groups.values()):
-            ax.set_xscale("log")
-            ax.xaxis.set_major_formatter(ScalarFormatter())
-            ax.xaxis.set_minor_formatter(plt.NullFormatter())
-        not_reached = len(not_reached)
-        ax.set_xlabel("years to the wear limit (continuous fretting)" if years else "cycles to the wear limit (–)")
-        ax.set_ylabel("samples (–)")
-        ax.grid(alpha=0.3)
-        ax.legend(fontsize=7)
-        ax.set_title(f"{Path(table.path).name}: {reached[0]['limit_reached']} limit"
-                     + (f" ({not_reached} samples did not reach it)" if not_reached else ""), fontsize=10)
-        fig.tight_layout()
-        path = outdir / f"uncertainty_time_to_limit.{fmt}"
-        _savefig(fig, path, dpi)
-        plt.close(fig)
-        paths.append(path)
-    return paths
+    return fig
+
+
+# the unit of a time to a limit (name, as labelled, hours): the largest in which the samples' median is at least
+# a tenth (0.47 years, not 171 days; 5 minutes, not 0.09 hours)
+TIME_UNITS = (("years", "years", 8766.0), ("days", "days", 24.0), ("hours", "h", 1.0), ("minutes", "min", 1 / 60),
+              ("seconds", "s", 1 / 3600))
+PERCENTILE_STYLES = (("P10", ":", "right"), ("P50", "-", "left"), ("P90", "--", "left"))  # name, line, text side
+
+
+def log_ticks(lo: float, hi: float) -> list[float]:
+    """Ticks of a log axis over ``lo`` to ``hi``: powers of ten, or where fewer than three of them fall inside,
+    1, 2 and 5 times them, then 1, 2, 3, 5, then every digit (a histogram within one decade had a single tick);
+    a range holding fewer than two digits gets those either side of it too (the axis is widened to them)."""
+    ticks: list = []
+    for subs in ((1,), (1, 2, 5), (1, 2, 3, 5), tuple(range(1, 10))):
+        decades = range(math.floor(math.log10(lo)), math.ceil(math.log10(hi)) + 1)
+        ticks = [float(f"{m}e{e}") for e in decades for m in subs if lo <= float(f"{m}e{e}") <= hi]
+        if len(ticks) >= 3:
+            return ticks
+    if len(ticks) >= 2:
+        return ticks
+    e_lo, e_hi = math.floor(math.log10(lo)), math.floor(math.log10(hi))
+    below = float(f"{math.floor(lo / 10.0 ** e_lo)}e{e_lo}")
+    above = float(f"{math.ceil(hi / 10.0 ** e_hi)}e{e_hi}")
+    return sorted({below, *ticks, above})
+
+
+def _log_tick(v: float) -> str:
+    """A tick of a log axis: as :func:`cycles_tick` from 1 up, 0.5 and 0.02 below."""
+    return cycles_tick(v) if v >= 1 else f"{v:g}"
+
+
+def _time_to_limit(table: SweepTable):
+    """Histogram of the time (with loading.frequency) or the cycles to the wear limit over the complete samples,
+    with their P10, P50 and P90 as labelled vertical lines; None where no sample reached a limit.  A sample that
+    did not reach it counts as beyond every one that did, as in percentiles.csv (the same quantiles)."""
+    from fretsim.uncertainty import quantiles
+    done = [r for r in table.rows if r.get("status") == "complete"]
+    reached = [r for r in done if r.get("limit_reached")]
+    if not reached:
+        return None
+    timed = all(_finite(r.get("time_to_limit_h")) for r in reached)
+    key = "time_to_limit_h" if timed else "cycles_to_limit"
+    unit, short, per = "cycles", "cycles", 1.0
+    if timed:
+        median = float(np.median([float(r[key]) for r in reached]))
+        unit, short, per = next((u for u in TIME_UNITS if median / u[2] >= 0.1), TIME_UNITS[-1])
+    groups: dict = {}
+    for r in done:
+        groups.setdefault(tuple(r.get(k) for k in table.groups), []).append(
+            float(r[key]) / per if r.get("limit_reached") else math.inf)
+    finite = np.array([v for vals in groups.values() for v in vals if math.isfinite(v)])
+    lo, hi = float(finite.min()), float(finite.max())
+    log = lo > 0
+    if log and hi <= lo * 1.05:  # one value (or nearly): a bin of ±5 % around it
+        lo, hi = lo / 1.05, hi * 1.05
+    elif not log and hi <= lo:
+        lo, hi = lo - 0.5, hi + 0.5
+    bins = int(np.clip(round(2 * math.sqrt(finite.size)), 6, 25))
+    edges = np.logspace(math.log10(lo), math.log10(hi), bins + 1) if log else np.linspace(lo, hi, bins + 1)
+    beyond = len(done) - len(reached)
+    last = max((int(float(r["cycles"])) for r in done if not r.get("limit_reached") and _finite(r.get("cycles"))),
+               default=0)
+    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    handles, top = [], 1
+    for i, (group, vals) in enumerate(groups.items()):
+        colour = f"C{i % 10}"
+        shown = [v for v in vals if math.isfinite(v)]
+        prefix = f"{_group_label(table, group)}: " if table.groups else ""
+        counts, _, bars = ax.hist(shown, bins=edges, color=colour, alpha=0.5,
+                                  label=f"{prefix}{len(shown)} of {len(vals)} samples reached the limit")
+        handles.append(bars.patches[0])  # the first bar carries the histogram's label
+        top = max(top, int(counts.max()) if len(counts) else 0)
+        ps = quantiles(vals)
+        for k, ((name, ls, side), p) in enumerate(zip(PERCENTILE_STYLES, ps)):
+            if k + 1 < len(ps) and ps[k + 1] == p:  # equal (a few samples): one line named by both, drawn once
+                continue
+            name = " = ".join(n for (n, _, _), q in zip(PERCENTILE_STYLES, ps) if q == p)
+            if not math.isfinite(p):
+                handles.append(ax.plot([], [], " ", label=f"{prefix}{name} beyond N = {cycles_tick(last)} "
+                                                          f"(not reached)")[0])
+                continue
+            text = f"{name} = {_value_text(p, short)}"  # the group is the line's colour, said in the legend
+            ax.axvline(p, color=colour, ls=ls, lw=1.3, label=prefix + text)
+            ax.text(p, 0.98, f" {text} ", transform=ax.get_xaxis_transform(), rotation=90, va="top", ha=side,
+                    fontsize=7, color=colour, bbox=dict(boxstyle="square,pad=0.1", fc="white", ec="none", alpha=0.8))
+    ax.set_ylim(0, top * 1.6)  # headroom for the percentiles' labels
+    ax.yaxis.set_major_locator(MaxNLocator(integer=True))  # whole samples
+    if log:
+        ax.set_xscale("log")
+        ticks = log_ticks(lo / 1.25, hi * 1.25)
+        ax.set_xlim(min(lo / 1.25, ticks[0]), max(hi * 1.25, ticks[-1]))
+        ax.set_xticks(ticks)
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: _log_tick(v)))
+        ax.xaxis.set_minor_formatter(plt.NullFormatter())
+    else:
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: cycles_tick(v)))
+    if timed:
+        r = reached[0]
+        hz = float(r["cycles_to_limit"]) / (float(r["time_to_limit_h"]) * 3600.0)
+        ax.set_xlabel(f"{unit} to the wear limit (continuous fretting at {hz:.3g} Hz)")
+    else:
+        ax.set_xlabel("cycles to the wear limit (–)")
+    ax.set_ylabel("samples (–)")
+    ax.grid(alpha=0.3)
+    # below the axes: inside, it lay over the percentiles' labels (which hold the top for them)
+    ax.legend(handles=handles, fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.16), frameon=False)
+    fig.set_figheight(4.2 + 0.17 * len(handles))
+    others = len(table.rows) - len(done)
+    notes = ([f"{_samples(beyond)} did not reach it by N = {cycles_tick(last)}"] if beyond else []) + (
+        [f"{_samples(others)} not complete, not counted"] if others else [])
+    ax.set_title(f"{Path(table.path).name}: {reached[0]['limit_reached']} limit"
+                 + (f" ({'; '.join(notes)})" if notes else ""), fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def _finite(text) -> bool:
+    try:
+        return math.isfinite(float(text))
+    except (TypeError, ValueError):
+        return False
+
+
+def _samples(n: int) -> str:
+    return f"{n} sample{'' if n == 1 else 's'}"
+
+
+def _value_text(v: float, unit: str) -> str:
+    """A percentile as it is labelled: three significant figures (a dozen or a few hundred samples know no more),
+    cycles as their ticks read (5 320 cycles, 1.03×10⁹ cycles)."""
+    if unit == "cycles":
+        return f"{cycles_tick(float(f'{v:.3g}'))} cycles"
+    return f"{v:.3g} {unit}"
 
 
 def _as_written(table: SweepTable, axis: str) -> list:

@@ -91,6 +91,17 @@ def sample(specs: dict, n: int, seed: int) -> list[dict]:
     return [{k: columns[k][i] for k in keys} for i in range(n)]
 
 
+def quantiles(values):
+    """P10, P50 and P90 of ``values`` (numbers, inf for a limit not reached): interpolated between the samples
+    where all are finite, else the sample at or above each fraction (an inf takes no part in an interpolation).
+    ``percentiles.csv`` and the time-to-limit figure both take them from here, so they agree."""
+    import numpy as np
+    values = np.sort(np.asarray(values, dtype=float))
+    if np.isfinite(values).all():
+        return np.percentile(values, PERCENTILES, method="linear")
+    return np.array([np.quantile(values, q / 100, method="inverted_cdf") for q in PERCENTILES])
+
+
 def percentiles(rows: list, group_keys: list, units: dict) -> list[dict]:
     """One row per (group, summary value): key, p10, p50, p90, its unit, the points it is over, those where it
     is missing and the group's points that did not complete (stopped at a physical limit, failed: not counted,
@@ -119,8 +130,7 @@ def percentiles(rows: list, group_keys: list, units: dict) -> list[dict]:
             finite = arr[~np.isnan(arr)]
             if not finite.size:
                 continue
-            p = np.percentile(finite, PERCENTILES, method="linear") if np.isfinite(finite).all() else \
-                np.array([np.quantile(np.sort(finite), q / 100, method="inverted_cdf") for q in PERCENTILES])
+            p = quantiles(finite)
             out.append({**dict(zip(group_keys, group)), "key": key, **{f"p{q}": float(v) for q, v in
                                                                         zip(PERCENTILES, p)},
                         "unit": unit, "points": int(finite.size), "missing": int(arr.size - finite.size),

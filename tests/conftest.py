@@ -154,3 +154,16 @@ def edited(path):
     with h5py.File(path, "r+") as f:
         yield f
     reseal_file(path)
+
+
+# --- figures --------------------------------------------------------------------------------------------------------
+
+def outside_canvas(fig) -> tuple | None:
+    """None where everything the figure draws (labels, legends, titles, rotated text) lies on its canvas (half a
+    pixel of rounding allowed), else the drawn box and the canvas, in pixels: what a saved figure would cut off."""
+    if not hasattr(fig.canvas, "get_renderer"):  # closed by pyplot after saving: drawn again on Agg's canvas
+        from matplotlib.backends.backend_agg import FigureCanvasAgg
+        FigureCanvasAgg(fig)
+    box = fig.get_tightbbox(fig.canvas.get_renderer()).transformed(fig.dpi_scale_trans)
+    inside = box.x0 >= -0.5 and box.y0 >= -0.5 and box.x1 <= fig.bbox.width + 0.5 and box.y1 <= fig.bbox.height + 0.5
+    return None if inside else (box.bounds, fig.bbox.bounds)

@@ -1,4 +1,5 @@
-"""Overlays (`fretsim plot A.h5 B.h5`): a run that did not complete is marked as such where it is drawn."""
+"""Overlays (`fretsim plot A.h5 B.h5`): each run labelled by what differs between the runs, and a run that did not
+complete marked as such where it is drawn."""
 from pathlib import Path
 
 import matplotlib.pyplot as plt
@@ -62,3 +63,70 @@ def test_plotting_an_overlay_with_a_run_that_did_not_complete_notes_it(two_runs,
     assert r.exit_code == 0, r.output
     assert f"note: {interrupted.path}: interrupted at cycle" in r.output, r.output
     assert f"note: {complete.path}" not in r.output, r.output
+
+
+@pytest.fixture(scope="module")
+def other_runs(two_runs):
+    """The same case at 150 N (C), and with five values changed (D): the load, the stroke, both wear coefficients
+    and the step tolerance."""
+    tmp = Path(two_runs[0].path).parent
+    base = ["model.dimension=2d", "loading.cycles=2000", "output.snapshots=[0, 100, 2000]", "grid.error_estimate=none"]
+    run(load_case(CASE, base + ["loading.normal_load=150 N"]), tmp / "C.h5")
+    changed = ["loading.normal_load=150 N", "loading.stroke=10 um", "materials.moving.wear_coefficient=3e-8 1/MPa",
+               "materials.stationary.wear_coefficient=1e-8 1/MPa", "jumping.tolerance=0.005"]
+    run(load_case(CASE, base + changed), tmp / "D.h5")
+    return read_results(tmp / "C.h5"), read_results(tmp / "D.h5")
+
+
+def test_overlaid_runs_are_labelled_by_the_set_value_that_differs_and_a_cut_short_one_by_its_status(two_runs,
+                                                                                                   other_runs):
+    """Each run was labelled by its case's name and file name: mccoll_185N (A), mccoll_185N (C)."""
+    complete, interrupted = two_runs
+    at_150, _ = other_runs
+    reached = int(interrupted.history["cycle"][-1])
+    fig = overlay([complete, interrupted, at_150])
+    try:
+        history = [t.get_text() for t in fig.axes[3].get_legend().get_texts()]
+        profiles = [t.get_text() for t in fig.axes[1].get_legend().get_texts()]
+        title = fig.texts[0].get_text()
+    finally:
+        plt.close(fig)
+    # the value that differs, from each filled case (A and B did not set it); the shared --set values not named
+    assert history == ["normal_load=185 N (A)",
+                       f"normal_load=185 N (B,\ninterrupted at cycle {reached} of 2 000)",
+                       "normal_load=150 N (C)"], history
+    assert profiles == ["normal_load=185 N (A), N = 2 000",  # and the last recorded state
+                        f"normal_load=185 N (B,\ninterrupted at cycle {reached} of 2 000), N = 100",
+                        "normal_load=150 N (C), N = 2 000"], profiles
+    assert title == "3 runs of mccoll_185N overlaid", title
+
+
+def test_a_label_names_three_differences_counts_the_rest_and_keeps_the_overlay_on_its_canvas(two_runs, other_runs):
+    """Five values differ: a label names the first three (each run's, in one spelling: A set none of them),
+    the wear coefficients by as much of their key as tells them apart, says how many more, breaks into lines of at
+    most LABEL_WIDTH characters between values, and every legend stays on the figure.  C and D share their load:
+    between them it is not named."""
+    from conftest import outside_canvas
+    from fretsim import plotting
+    complete, interrupted = two_runs
+    at_150, changed = other_runs
+    reached = int(interrupted.history["cycle"][-1])
+    fig = overlay([complete, interrupted, at_150, changed], expected=True)
+    try:
+        history = [t.get_text() for t in fig.axes[3].get_legend().get_texts()]
+        runs = [t.get_text() for ax in fig.axes for t in ax.get_legend().get_texts() if not t.get_text().startswith(
+            ("experiment", "fea", "paper"))]
+        outside = outside_canvas(fig)
+    finally:
+        plt.close(fig)
+    assert history == [
+        "normal_load=185 N, stroke=0.025 mm,\nmoving.wear_coefficient=2e-08 1/MPa, +2 more (A)",
+        f"normal_load=185 N, stroke=0.025 mm,\nmoving.wear_coefficient=2e-08 1/MPa, +2 more (B,\ninterrupted at "
+        f"cycle {reached} of 2 000)",
+        "normal_load=150 N, stroke=0.025 mm,\nmoving.wear_coefficient=2e-08 1/MPa, +2 more (C)",
+        "normal_load=150 N, stroke=0.01 mm,\nmoving.wear_coefficient=3e-08 1/MPa, +2 more (D)"], history
+    assert len(runs) == 16 and all(len(line) <= plotting.LABEL_WIDTH for t in runs for line in t.splitlines()), runs
+    assert outside is None, outside
+    assert plotting.run_labels([at_150, changed]) == [
+        "stroke=0.025 mm,\nmoving.wear_coefficient=2e-08 1/MPa,\nstationary.wear_coefficient=3e-08 1/MPa, +1 more\n(C)",
+        "stroke=0.01 mm,\nmoving.wear_coefficient=3e-08 1/MPa,\nstationary.wear_coefficient=1e-08 1/MPa, +1 more\n(D)"]

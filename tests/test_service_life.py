@@ -2,7 +2,7 @@
 import numpy as np
 import pytest
 
-from conftest import check_archard
+from conftest import check_archard, outside_canvas
 from fretsim.api import load_case, parse_case, run
 from fretsim.case import CaseError
 from fretsim.loading import Block, expand
@@ -306,6 +306,129 @@ axes:
     assert reached
     paths = uncertainty_bands(table, out, "png", 60)
     assert [p.name for p in paths] == ["uncertainty_depth_band.png", "uncertainty_time_to_limit.png"]
+
+
+LIMITED = f"""
+base: {CASES / 'mccoll_185N.yaml'}
+set: [model.dimension=2d, loading.cycles=20000, "output.snapshots=[0]", grid.error_estimate=none,
+      limits.max_wear_depth_moving=1 um, loading.frequency=30 Hz]
+sample: {{n: 10, seed: 3}}
+axes:
+  materials.moving.wear_coefficient: {{distribution: lognormal, median: 2e-8 1/MPa, factor: 2}}
+  loading.stroke: [10 um, 25 um]
+"""
+
+
+@pytest.fixture(scope="session")  # per worker, once: xdist interleaves modules, a module fixture is rebuilt
+def limited_sweep(tmp_path_factory):
+    """Ten samples of k at each of two strokes, run to a 1 µm limit at 30 Hz (3 s): at 25 µm nine reach it, at
+    10 µm six, so that group's P90 lies beyond the runs' 20 000 cycles."""
+    from fretsim.results import read_sweep_table
+    path = tmp_path_factory.mktemp("limited") / "l.yaml"
+    path.write_text(LIMITED)
+    out = path.parent / "l"
+    assert run_sweep(load_sweep(path), out, jobs=2).all_complete
+    with open(out / "percentiles.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    return read_sweep_table(out), rows
+
+
+@pytest.fixture(scope="session")
+def limited_plots(limited_sweep, tmp_path_factory) -> dict:
+    """The figures `fretsim plot DIR` saves (file stem → Figure, whichever function draws them), of the table as
+    run at 30 Hz ("minutes") and as a sweep without loading.frequency writes it ("cycles")."""
+    import dataclasses
+
+    from matplotlib.figure import Figure
+
+    from fretsim.plotting import plot_sweep
+    table, _ = limited_sweep
+    save = Figure.savefig
+    out = {}
+    no_frequency = dataclasses.replace(table, rows=[{**r, "time_to_limit_h": "nan"} for r in table.rows])
+    for unit, tab in (("cycles", no_frequency), ("minutes", table)):
+        saved = out[unit] = {}
+
+        def record(fig, fname, *args, **kwargs):
+            saved[Path(str(fname)).stem] = fig
+            return save(fig, fname, *args, **kwargs)
+        with pytest.MonkeyPatch.context() as mp:
+            mp.setattr(Figure, "savefig", record)
+            plot_sweep(tab, tmp_path_factory.mktemp(unit), dpi=60)
+    return out
+
+
+def _visible_ticks(axis, lo, hi) -> list:
+    return [(t.get_loc(), t.label1.get_text()) for t in axis.get_major_ticks() if lo <= t.get_loc() <= hi]
+
+
+def test_the_time_to_limit_histogram_counts_whole_samples_on_log_ticks_that_read(limited_plots):
+    """Its y axis read 0.2, 0.4 … samples, and its log x axis one tick, 10000, over a decade of data."""
+    from fretsim.plotting import cycles_tick
+    for unit in ("cycles", "minutes"):
+        fig = limited_plots[unit]["uncertainty_time_to_limit"]
+        ax = fig.axes[0]
+        assert outside_canvas(fig) is None, outside_canvas(fig)
+        counts = [loc for loc, _ in _visible_ticks(ax.yaxis, *ax.get_ylim())]
+        assert len(counts) >= 2 and all(float(c).is_integer() for c in counts), counts
+        assert ax.get_xscale() == "log" and ax.get_xlabel().startswith(f"{unit} to the wear limit")
+        ticks = _visible_ticks(ax.xaxis, *ax.get_xlim())
+        assert len(ticks) >= 3, ticks
+        if unit == "cycles":  # 10⁵ and up as powers of ten, as the history's axis reads
+            assert [text for _, text in ticks] == [cycles_tick(v) for v, _ in ticks], ticks
+            assert all(float(f"{v:.0e}") == v for v, _ in ticks), ticks  # 1, 2, 5 (3) times a power of ten
+        else:  # 0.5, 1, 2, 5, 10 minutes
+            assert [text for _, text in ticks] == [f"{v:g}" for v, _ in ticks], ticks
+
+
+def test_the_time_to_limit_histogram_draws_p10_p50_p90_where_percentiles_csv_has_them_each_labelled_with_its_value(
+        limited_sweep, limited_plots):
+    """P10, P50 and P90 are vertical lines at the values of percentiles.csv (a sample short of the limit counted
+    beyond every one that reached it), each with its value and unit beside it; one beyond the runs is said so."""
+    from fretsim.plotting import cycles_tick
+    _, percentiles = limited_sweep
+    for drawn, key, unit in (("cycles", "cycles_to_limit", "cycles"), ("minutes", "time_to_limit_h", "min")):
+        fig = limited_plots[drawn]["uncertainty_time_to_limit"]
+        ax = fig.axes[0]
+        vertical = [ln for ln in ax.lines if len(ln.get_xdata()) == 2 and ln.get_xdata()[0] == ln.get_xdata()[1]]
+        lines = {ln.get_label(): ln.get_xdata()[0] for ln in vertical}
+        texts = {t.get_text().strip(): t.get_position()[0] for t in ax.texts}
+        legend = [t.get_text() for t in ax.get_legend().get_texts()]
+        rows = [r for r in percentiles if r["key"] == key]
+        assert {r["loading.stroke"] for r in rows} == {"10 um", "25 um"}
+        beyond = 0
+        for r in rows:
+            for name in ("P10", "P50", "P90"):
+                p = float(r[name.lower()]) * (60 if unit == "min" else 1)
+                if math.isinf(p):
+                    beyond += 1
+                    assert f"stroke = {r['loading.stroke']}: {name} beyond N = 20 000 (not reached)" in legend, legend
+                    continue
+                value = f"{cycles_tick(float(f'{p:.3g}')) if unit == 'cycles' else f'{p:.3g}'} {unit}"
+                label = f"{name} = {value}"
+                assert lines[f"stroke = {r['loading.stroke']}: {label}"] == pytest.approx(p, rel=1e-12), lines
+                assert texts[label] == pytest.approx(p, rel=1e-12), texts
+        assert beyond == 1  # the 10 µm stroke's P90: four of its ten samples did not reach the limit
+        assert len(lines) == len(texts) == 5
+
+
+def test_the_depth_band_names_its_percentiles_and_draws_them(limited_sweep, limited_plots):
+    """The band said "median" and "P10-P90": which band is which percentile, by name."""
+    from fretsim.plotting import band_data
+    table, _ = limited_sweep
+    fig = limited_plots["minutes"]["uncertainty_depth_band"]
+    assert outside_canvas(fig) is None, outside_canvas(fig)
+    ax = fig.axes[0]
+    assert [t.get_text() for t in ax.get_legend().get_texts()] == [
+        f"stroke = {s}: {what}" for s in ("10 um", "25 um") for what in ("P50 (median)", "P10–P90 of 10 samples")]
+    bands = band_data(table)
+    for line, band in zip(ax.lines, (c for c in ax.collections)):
+        group = (line.get_label().split(":")[0].split(" = ")[1],)
+        b = bands[group]
+        assert np.array_equal(line.get_ydata(), b["p50"])
+        y = band.get_paths()[0].vertices[:, 1]
+        assert y.min() == pytest.approx(b["p10"].min()) and y.max() == pytest.approx(b["p90"].max())
+        assert band.get_label() == f"stroke = {group[0]}: P10–P90 of 10 samples"
 
 
 # --- wear coefficients fitted to measurements ---------------------------------------------------------------------
