@@ -50,3 +50,16 @@ def scar_width(profile: np.ndarray, x: np.ndarray, fraction: float = 1e-3) -> fl
         return float(x[i_out] + (x[i_in] - x[i_out]) * (level - a) / (b - a))
 
     return crossing(i1, i1 + 1) - crossing(i0, i0 - 1)
+
+
+PERCENTILES = (10, 50, 90)  # what a sampled sweep reports of each value (percentiles.csv, the uncertainty figure)
+
+
+def quantiles(values) -> np.ndarray:
+    """P10, P50 and P90 of ``values`` (numbers, inf for a limit not reached): interpolated between the samples
+    where all are finite, else the sample at or above each fraction (an inf takes no part in an interpolation).
+    ``percentiles.csv`` and the time-to-limit figure both take them from here, so they agree."""
+    values = np.sort(np.asarray(values, dtype=float))
+    if np.isfinite(values).all():
+        return np.percentile(values, PERCENTILES, method="linear")
+    return np.array([np.quantile(values, q / 100, method="inverted_cdf") for q in PERCENTILES])

@@ -22,7 +22,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FuncFormatter, MaxNLocator  # noqa: E402
 
-from fretsim.measures import centre_line  # noqa: E402
+from fretsim.measures import centre_line, quantiles  # noqa: E402
 from fretsim.quantities import SUMMARY  # noqa: E402
 from fretsim.results import Results, ResultsFileError, SweepTable  # noqa: E402
 
@@ -316,22 +316,7 @@ def _fill(chunks: list, width: int = LABEL_WIDTH) -> str:
 
 def _case_values(res: Results) -> dict:
     """The filled case stored in the file as dotted key → value as text (its name and published values aside)."""
-    from fretsim.yamlread import YamlProblem, loads
-    try:
-        case = loads(res.case_yaml) or {}
-    except YamlProblem:
-        return {}
-    out: dict = {}
-
-    def walk(node, prefix):
-        for k, v in node.items():
-            if isinstance(v, dict):
-                walk(v, f"{prefix}{k}.")
-            else:
-                out[f"{prefix}{k}"] = _as_text(v)
-    if isinstance(case, dict):
-        walk({k: v for k, v in case.items() if k not in ("name", "expected")}, "")
-    return out
+    return {k: _as_text(v) for k, v in res.case_values().items()}
 
 
 def _asked(res: Results) -> dict:
@@ -920,7 +905,6 @@ def _time_to_limit(table: SweepTable):
     """Histogram of the time (with loading.frequency) or the cycles to the wear limit over the complete samples,
     with their P10, P50 and P90 as labelled vertical lines; None where no sample reached a limit.  A sample that
     did not reach it counts as beyond every one that did, as in percentiles.csv (the same quantiles)."""
-    from fretsim.uncertainty import quantiles
     done = [r for r in table.rows if r.get("status") == "complete"]
     reached = [r for r in done if r.get("limit_reached")]
     if not reached:
@@ -972,15 +956,7 @@ def _time_to_limit(table: SweepTable):
                     fontsize=7, color=colour, bbox=dict(boxstyle="square,pad=0.1", fc="white", ec="none", alpha=0.8))
     ax.set_ylim(0, top * 1.6)  # headroom for the percentiles' labels
     ax.yaxis.set_major_locator(MaxNLocator(integer=True))  # whole samples
-    if log:
-        ax.set_xscale("log")
-        ticks = log_ticks(lo / 1.25, hi * 1.25)
-        ax.set_xlim(min(lo / 1.25, ticks[0]), max(hi * 1.25, ticks[-1]))
-        ax.set_xticks(ticks)
-        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: _log_tick(v)))
-        ax.xaxis.set_minor_formatter(plt.NullFormatter())
-    else:
-        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: cycles_tick(v)))
+    _limit_axis(ax, log, lo, hi)
     if timed:
         r = reached[0]
         hz = float(r["cycles_to_limit"]) / (float(r["time_to_limit_h"]) * 3600.0)
@@ -999,6 +975,19 @@ def _time_to_limit(table: SweepTable):
                  + (f" ({'; '.join(notes)})" if notes else ""), fontsize=9)
     fig.tight_layout()
     return fig
+
+
+def _limit_axis(ax, log: bool, lo: float, hi: float) -> None:
+    """The time-to-limit axis: log ticks that read (1-2-5, as powers of ten past 10⁵), or cycles on a linear one."""
+    if log:
+        ax.set_xscale("log")
+        ticks = log_ticks(lo / 1.25, hi * 1.25)
+        ax.set_xlim(min(lo / 1.25, ticks[0]), max(hi * 1.25, ticks[-1]))
+        ax.set_xticks(ticks)
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: _log_tick(v)))
+        ax.xaxis.set_minor_formatter(plt.NullFormatter())
+    else:
+        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: cycles_tick(v)))
 
 
 def _finite(text) -> bool:

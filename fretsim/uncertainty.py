@@ -21,7 +21,6 @@ import math
 from typing import Optional
 
 DISTRIBUTIONS = {"normal": ("mean", "sd"), "lognormal": ("median", "factor"), "uniform": ("low", "high")}
-PERCENTILES = (10, 50, 90)
 
 
 def _split(value) -> tuple[float, str]:
@@ -91,22 +90,12 @@ def sample(specs: dict, n: int, seed: int) -> list[dict]:
     return [{k: columns[k][i] for k in keys} for i in range(n)]
 
 
-def quantiles(values):
-    """P10, P50 and P90 of ``values`` (numbers, inf for a limit not reached): interpolated between the samples
-    where all are finite, else the sample at or above each fraction (an inf takes no part in an interpolation).
-    ``percentiles.csv`` and the time-to-limit figure both take them from here, so they agree."""
-    import numpy as np
-    values = np.sort(np.asarray(values, dtype=float))
-    if np.isfinite(values).all():
-        return np.percentile(values, PERCENTILES, method="linear")
-    return np.array([np.quantile(values, q / 100, method="inverted_cdf") for q in PERCENTILES])
-
-
 def percentiles(rows: list, group_keys: list, units: dict) -> list[dict]:
     """One row per (group, summary value): key, p10, p50, p90, its unit, the points it is over, those where it
     is missing and the group's points that did not complete (stopped at a physical limit, failed: not counted,
     which biases the percentiles if they are many).  A limit never reached (cycles_to_limit NaN) counts as beyond every reached one: its percentile is
     then inf ('not reached within loading.cycles')."""
+    from fretsim.measures import PERCENTILES, quantiles
     import numpy as np
     done = [r for r in rows if r.get("status") == "complete"]
     groups: dict = {}

@@ -45,6 +45,26 @@ class Results:
     def status(self) -> str:
         return self.attrs.get("status", "")
 
+    def case_values(self) -> dict:
+        """The filled case stored in the file as dotted key → value (its name and published values aside; {} where
+        it cannot be read)."""
+        from fretsim.yamlread import YamlProblem, loads
+        try:
+            case = loads(self.case_yaml) or {}
+        except YamlProblem:
+            return {}
+        out: dict = {}
+
+        def walk(node, prefix):
+            for k, v in node.items():
+                if isinstance(v, dict):
+                    walk(v, f"{prefix}{k}.")
+                else:
+                    out[f"{prefix}{k}"] = v
+        if isinstance(case, dict):
+            walk({k: v for k, v in case.items() if k not in ("name", "expected")}, "")
+        return out
+
     def _case_section(self, name: str) -> dict:
         """A top-level mapping of the stored case ({} where absent or not a mapping)."""
         from fretsim.yamlread import YamlProblem, loads
