@@ -3,8 +3,9 @@
 After the paper: wear profiles across the contact (Fig. 17) and, in 3D, along it; pressure profiles (Fig. 16)
 with the initial Hertz solution; wear maps of both bodies, each on its own round colour scale (Figs. 24–25), and the pressure
 map (the finite cylinder's end peaks, Fig. 5); maximum depth and wear volume against cycles (Figs. 14, 28)
-with Archard's line and a marker at every contact solve.  They read only the results file: :func:`figures`
-returns the matplotlib figures (tests check what is drawn), :func:`plot_all` saves them.
+with Archard's line and a marker at every contact solve, and against time where the case gives a frequency, with
+the load blocks, the wear limits and where the run stopped at one.  They read only the results file:
+:func:`figures` returns the matplotlib figures (tests check what is drawn), :func:`plot_all` saves them.
 """
 from __future__ import annotations
 
@@ -55,18 +56,23 @@ def title_block(res: Results) -> str:
     parts = [f"{name}{status}"]
     blocks = res.history.get("block")
     nblocks = int(np.max(blocks)) + 1 if blocks is not None and len(blocks) else 1
+    stop = _stop_line(res)
+    # at a wear limit loading.cycles is only an upper bound: the stop's own line says how long the run was
+    length = "" if stop else f"N = {_number(res, 'cycles', '.0f')}{_time_of(res, _float(res, 'cycles'), short=True)}, "
     if res.inputs and nblocks > 1:
         parts.append(f"load history of {nblocks} blocks: P ≤ {_number(res, 'normal_load', '.4g')} N, δ ≤ "
-                     f"±{_number(res, 'stroke', '.4g')} µm, N = {_number(res, 'cycles', '.0f')}, k_m = "
+                     f"±{_number(res, 'stroke', '.4g')} µm, {length}k_m = "
                      f"{_number(res, 'moving_wear_coefficient', '.3g')}, k_s = "
                      f"{_number(res, 'stationary_wear_coefficient', '.3g')} 1/MPa; "
                      f"{str(_input(res, 'dimension', '')).upper()} {_input(res, 'geometry', '')}, "
                      f"{_input(res, 'scheme', '')}")
     elif res.inputs:
         parts.append(f"P = {_number(res, 'normal_load', '.4g')} N, δ = ±{_number(res, 'stroke', '.4g')} µm, "
-                     f"N = {_number(res, 'cycles', '.0f')}, {_coefficients(res)}; "
+                     f"{length}{_coefficients(res)}; "
                      f"{str(_input(res, 'dimension', '')).upper()} {_input(res, 'geometry', '')}, gap "
                      f"{_input(res, 'gap_model', '')}, {_input(res, 'scheme', '')}")
+    if stop:
+        parts.append(stop)
     if res.overrides:  # wrapped: a long --set line ran off the figure's top
         parts += textwrap.wrap("--set " + " ".join(res.overrides), TITLE_WIDTH, break_long_words=False)
     est = [(label, res.summary.get(f"estimated_error_{key}")) for label, key in
@@ -74,9 +80,27 @@ def title_block(res: Results) -> str:
     if all(isinstance(v, float) and math.isfinite(v) for _, v in est):
         parts.append("estimated error (stepping + grid + model): "
                      + ", ".join(f"{label} ±{_percent(v)}" for label, v in est))
-    if res.summary.get("limit_reached"):
-        parts.append(f"wear limit {res.summary['limit_reached']} reached at N = {res.summary['cycles_to_limit']:,.0f}")
     return "\n".join(parts)
+
+
+def _stop_line(res: Results) -> str:
+    """Where a run stopped at a wear limit, in cycles and (with loading.frequency) time; "" for any other run."""
+    key = res.summary.get("limit_reached")
+    if not key:
+        return ""
+    n = float(res.summary["cycles_to_limit"])
+    cycles = f"{n:,.0f}".replace(",", " ")
+    return f"stopped at {cycles} cycles (limit {key} reached){_time_of(res, n)}"
+
+
+def _time_of(res: Results, n: Optional[float], short: bool = False) -> str:
+    """", 1 710 h of continuous fretting at 30 Hz" (short: " (1 710 h at 30 Hz)") for ``n`` cycles where the case
+    gives a frequency, else ""."""
+    time = _run_time(res)
+    if time is None or n is None:
+        return ""
+    duration = _duration(n / time[2], time[1])
+    return f" ({duration} at {time[0]:g} Hz)" if short else f", {duration} of continuous fretting at {time[0]:g} Hz"
 
 
 TITLE_WIDTH = 150  # characters of a title line at fontsize 9 across the narrowest figure (11 in)
@@ -100,9 +124,49 @@ def _unit(res: Results, key: str) -> str:
     return res.units.get(key, "").replace("um", "µm").replace("mm^3", "mm³")
 
 
-def _snapshot_lines(ax, x, curves, labels, sign=1.0):
-    for k, (c, label) in enumerate(zip(curves, labels)):
-        ax.plot(x, sign * c, ls=STYLES[k % len(STYLES)], lw=1.4, label=label)
+MAX_PROFILES = 6  # labelled profiles a panel draws at most: beyond, the legend and the colours stop reading
+
+
+def shown_states(count: int, most: int = MAX_PROFILES) -> np.ndarray:
+    """Which of ``count`` recorded states a profile panel draws: all of them up to ``most``, else ``most`` spread
+    evenly over the record, the first and the last among them (snapshots at 0, 10, 100, 1000 … keep their
+    spacing, which the user chose)."""
+    if count <= most:
+        return np.arange(count)
+    return np.unique(np.round(np.linspace(0, count - 1, most)).astype(int))
+
+
+def state_colours(count: int) -> list:
+    """A sequential order: the first state light, the last dark (viridis, perceptually ordered, and ordered in
+    grey when printed so); its palest yellow left out, which vanished on white."""
+    cmap = plt.get_cmap("viridis")
+    return [cmap(v) for v in (np.linspace(0.85, 0.05, count) if count > 1 else [0.05])]
+
+
+def _snapshot_lines(ax, x, curves, labels, sign=1.0) -> int:
+    """One line per shown recorded state (at most MAX_PROFILES, coloured in order); returns how many are shown."""
+    shown = shown_states(len(curves))
+    for k, colour in zip(shown, state_colours(len(shown))):
+        ax.plot(x, sign * curves[k], color=colour, lw=1.4, label=labels[k])
+    return len(shown)
+
+
+def _profile_figure(three_d: bool):
+    """Two panels a row (one row in 2D, two in 3D) and, right of them, a column for the legend of the recorded
+    states: inside a panel of nested profiles it lay over them."""
+    rows = 2 if three_d else 1
+    fig = plt.figure(figsize=(12.5, 7.5 if three_d else 4.2))
+    gs = fig.add_gridspec(rows, 3, width_ratios=[1, 1, 0.5])
+    axes = np.array([[fig.add_subplot(gs[r, c]) for c in range(2)] for r in range(rows)])
+    key = fig.add_subplot(gs[:, 2])
+    key.set_axis_off()
+    return fig, axes, key
+
+
+def _state_legend(key, ax, shown: int, recorded: int) -> None:
+    """The legend of ``ax``'s lines in the legend column, saying how many of the recorded states it shows."""
+    title = "recorded states" + (f" ({shown} of {recorded} shown)" if shown < recorded else "")
+    key.legend(*ax.get_legend_handles_labels(), loc="upper left", fontsize=8, title=title, title_fontsize=8)
 
 
 _SUPERSCRIPT = str.maketrans("0123456789-", "⁰¹²³⁴⁵⁶⁷⁸⁹⁻")
@@ -123,6 +187,46 @@ def cycles_tick(v: float) -> str:
 
 def _cycles_label(n: int) -> str:
     return f"N = {n:,}".replace(",", " ")
+
+
+HOURS_PER_YEAR = 8766.0  # a Julian year, as `run`'s summary and the sweep's histogram count years
+
+
+def time_unit(cycles: float, frequency: float) -> tuple[str, float]:
+    """The unit a run of ``cycles`` at ``frequency`` (Hz) reads best in, and the cycles in one of it: minutes
+    below an hour of continuous fretting, hours below a year, years from one (a wall limit at 1.09 years reads
+    1.09 years, one at 0.195 years 1 710 h)."""
+    per_hour = frequency * 3600.0
+    if cycles < per_hour:
+        return "min", frequency * 60.0
+    if cycles < per_hour * HOURS_PER_YEAR:
+        return "h", per_hour
+    return "years", per_hour * HOURS_PER_YEAR
+
+
+def _run_time(res: Results) -> Optional[tuple[float, str, float]]:
+    """(frequency Hz, unit, cycles per unit) for the run's time axis and labels, or None without a frequency;
+    the unit chosen once for the run's length, so every figure of a run reads time alike."""
+    f = res.frequency()
+    if f is None:
+        return None
+    last = max([float(c[-1]) for c in (res.history.get("cycle"), res.fields.get("cycle")) if c is not None and
+                len(c)] + [0.0])
+    unit, per = time_unit(last, f)
+    return f, unit, per
+
+
+def _duration(value: float, unit: str) -> str:
+    """A time in its unit as it reads: 1 710 h, 0.195 years, 12.5 min."""
+    number = f"{value:,.0f}".replace(",", " ") if abs(value) >= 100 else f"{value:.3g}"
+    return f"{number} {unit}"
+
+
+def _state_label(n: float, time: Optional[tuple]) -> str:
+    """A recorded state: its cycle as the axes read it (N = 20 000, N = 1.5×10⁸), and its time where the run has
+    one (``time``: :func:`_run_time`)."""
+    label = f"N = {cycles_tick(n)}"
+    return label if time is None else f"{label}, {_duration(n / time[2], time[1])}"
 
 
 def _builders(res: Results, log_cycles: bool) -> dict:
@@ -164,7 +268,9 @@ def figures(res: Results, log_cycles: bool = False, names=None) -> dict:
         # rows and the 3D fretting figure's x labels fell off the canvas)
         specs = [ax.get_subplotspec() for ax in fig.axes if ax.get_subplotspec()]
         rows = specs[0].get_gridspec().nrows if specs else 1
-        top = 1 - (0.45 + 0.18 * (1 + title.count("\n"))) / fig.get_figheight()
+        # a cycles axis on top (the history's, under a time axis) takes its tick labels and label there
+        above = 0.5 if any(ax.xaxis.get_label_position() == "top" for ax in fig.axes) else 0.0
+        top = 1 - (0.45 + above + 0.18 * (1 + title.count("\n"))) / fig.get_figheight()
         fig.subplots_adjust(left=0.07 if name != "maps" else 0.05, right=0.97 if name != "maps" else 0.95,
                             bottom=0.09 if rows > 1 else 0.14, top=top, hspace=0.42,
                             wspace=0.22 if name != "maps" else 0.08)
@@ -470,17 +576,19 @@ def published_profiles(panels: list, path: str | Path) -> Path:
 
 
 def _profiles(res: Results):
-    """Wear profiles of both bodies at every worn snapshot: across the contact (y = 0) and, in 3D, along it."""
+    """Wear profiles of both bodies at the worn recorded states (up to MAX_PROFILES of them, spread over the
+    record, light to dark): across the contact (y = 0) and, in 3D, along it."""
     cycles = res.fields["cycle"]
     worn = np.flatnonzero(cycles > 0)
     three_d = res.y.size > 1
-    fig, axes = plt.subplots(2 if three_d else 1, 2, figsize=(11, 7.5 if three_d else 4.2), squeeze=False)
-    labels = [_cycles_label(cycles[k]) for k in worn]
+    fig, axes, key = _profile_figure(three_d)
+    time = _run_time(res)
+    labels = [_state_label(cycles[k], time) for k in worn]
     unit = _unit(res, "fields/wear_depth_moving")
     for col, body in enumerate(("moving", "stationary")):
         data = res.fields[f"wear_depth_{body}"]
         ax = axes[0, col]
-        _snapshot_lines(ax, res.x, [centre_line(data[k]) for k in worn], labels, sign=-1.0)
+        shown = _snapshot_lines(ax, res.x, [centre_line(data[k]) for k in worn], labels, sign=-1.0)
         ax.set_xlabel("x, sliding direction (mm)")
         ax.set_ylabel(f"worn profile, −depth ({unit})")
         ax.set_title(f"{body} body, across the contact (y = 0)")
@@ -494,7 +602,7 @@ def _profiles(res: Results):
             ax.set_title(f"{body} body, along the contact (x = {res.x[ix]:.3g} mm)")
     for ax in axes.ravel():
         ax.grid(alpha=0.3)
-    axes[0, 1].legend(fontsize=8)
+    _state_legend(key, axes[0, 1], shown, len(worn))
     return fig
 
 
@@ -508,13 +616,14 @@ def hertz_profile(res: Results, x: np.ndarray) -> np.ndarray | None:
 
 
 def _pressure(res: Results):
-    """Pressure at every snapshot along y = 0 (moving body, stroke average) and, in 3D, along x = 0; the N = 0
-    curve is overlaid by Hertz's solution.  The scale follows the worn states: an unworn peak far above them is
-    cut off and labelled, instead of squashing them."""
+    """Pressure at the recorded states (up to MAX_PROFILES) along y = 0 (moving body, stroke average) and, in 3D,
+    along x = 0; the N = 0 curve is overlaid by Hertz's solution.  The scale follows the worn states: an unworn
+    peak far above them is cut off and labelled, instead of squashing them."""
     cycles = res.fields["cycle"]
     three_d = res.y.size > 1
-    fig, axes = plt.subplots(2 if three_d else 1, 2, figsize=(11, 7.5 if three_d else 4.2), squeeze=False)
-    labels = [_cycles_label(c) for c in cycles]
+    fig, axes, key = _profile_figure(three_d)
+    time = _run_time(res)
+    labels = [_state_label(c, time) for c in cycles]
     unit = _unit(res, "fields/pressure")
     worn = cycles > 0
     hertz = hertz_profile(res, res.x)
@@ -523,7 +632,7 @@ def _pressure(res: Results):
         data = res.fields[name]
         ax = axes[0, col]
         rows = [centre_line(d) for d in data]
-        _snapshot_lines(ax, res.x, rows, labels)
+        shown = _snapshot_lines(ax, res.x, rows, labels)
         if name == "pressure" and hertz is not None and 0 in cycles and _input(res, "hertz_line_contact", 1) in (1, 0):
             ax.plot(res.x, hertz, "k:", lw=1.0, label="Hertz (N = 0)")
         if worn.any() and (~worn).any():
@@ -554,7 +663,7 @@ def _pressure(res: Results):
             ax.set_title(f"{short}, along y at x = {res.x[ix]:.3g} mm")
     for ax in axes.ravel():
         ax.grid(alpha=0.3)
-    axes[0, 0].legend(fontsize=8)
+    _state_legend(key, axes[0, 0], shown, len(cycles))
     return fig
 
 
@@ -600,40 +709,29 @@ def _maps(res: Results):
 
 
 def _history(res: Results, log_cycles: bool):
-    """Maximum depth and wear volume against cycles, a marker at each solve, Archard's volume line."""
+    """Maximum depth and wear volume against cycles (and, with loading.frequency, time), a marker at each solve,
+    Archard's volume line, the load blocks, the case's wear limits and where the run stopped at one."""
     h = res.history
     n = h["cycle"]
-    fig, axes = plt.subplots(1, 2, figsize=(11, 4.4))
+    time = _run_time(res)
+    # a time axis below and the cycles above take half an inch more: the panels keep their height
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.4 if time is None else 4.9))
+    curves = {}  # history entry → its line, for the limits drawn beside them
     ax = axes[0]
     for (name, label), ls in zip((("max_wear_depth_total", "total"), ("max_wear_depth_stationary", "stationary"),
                                   ("max_wear_depth_moving", "moving")), STYLES):
-        ax.plot(n, h[name], ls=ls, marker="o", ms=2.5, lw=1.3, label=label)
+        curves[name], = ax.plot(n, h[name], ls=ls, marker="o", ms=2.5, lw=1.3, label=label)
     ax.set_ylabel(f"maximum wear depth ({_unit(res, 'history/max_wear_depth_total')})")
     ax = axes[1]
     for (name, label, key), ls in zip((("wear_volume_moving", "moving", "moving_wear_coefficient"),
                                        ("wear_volume_stationary", "stationary", "stationary_wear_coefficient")),
                                       STYLES):
         line, = ax.plot(n, h[name], ls=ls, marker="o", ms=2.5, lw=1.3, label=label)
-        k, load, stroke = _float(res, key), _float(res, "normal_load"), _float(res, "stroke")
-        energy_law = _input(res, "wear_law") == "energy"
-        if energy_law:
-            k = _float(res, key.replace("wear_coefficient", "energy_wear_coefficient"))
-            k = None if k is None else k * 1e-3  # mm³/J → mm³/(N·mm)
-        work = h.get("wear_work")
-        blocks = h.get("block")
-        history = blocks is not None and len(np.unique(blocks)) > 1
-        if k is not None and work is not None and np.isfinite(work).all() and history and not energy_law:
-            ax.plot(n, k * work, color=line.get_color(), lw=0.8, alpha=0.6, ls=(0, (1, 2)),
-                    label=f"Archard Σk·P·4δ·N over the blocks, {label}")
-        elif k is not None and work is not None and np.isfinite(work).all() and _input(res, "slip_model") == "coulomb":
-            ax.plot(n, k * work, color=line.get_color(), lw=0.8, alpha=0.6, ls=(0, (1, 2)),
-                    label=f"{'α·ΣW' if energy_law else 'k·Σp|ds|A'}, {label}")
-        elif None not in (k, load, stroke) and not energy_law:
-            archard = k * load * 4 * stroke * 1e-3 * n
-            ax.plot(n, archard, color=line.get_color(), lw=0.8, alpha=0.6, ls=(0, (1, 2)),
-                    label=f"Archard k·P·4δ·N, {label}")
+        curves[name] = line
+        _archard_line(res, ax, n, line, label, key)
     ax.set_ylabel(f"wear volume ({_unit(res, 'history/wear_volume_moving')})")
-    _mark_blocks_and_limit(res, axes)
+    _mark_blocks(res, axes)
+    _mark_limits(res, axes, curves, time)
     for ax in axes:
         ax.set_xlabel("cycles N (–)")
         if log_cycles:
@@ -641,6 +739,8 @@ def _history(res: Results, log_cycles: bool):
         else:
             ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: cycles_tick(v)))
             ax.tick_params(axis="x", labelrotation=20)
+        if time is not None:
+            _time_axis(ax, time)
         ax.grid(alpha=0.3, which="both")
         ax.legend(fontsize=8)
     axes[0].set_title("maximum wear depth (a marker per contact solve)")
@@ -648,12 +748,44 @@ def _history(res: Results, log_cycles: bool):
     return fig
 
 
+def _archard_line(res: Results, ax, n, line, label: str, key: str) -> None:
+    """The volume's invariant beside the volume: Σk·P·4δ·N over a load history's blocks, k·Σp|ds|A (α·ΣW) with
+    friction, or k·P·4δ·N."""
+    h = res.history
+    k, load, stroke = _float(res, key), _float(res, "normal_load"), _float(res, "stroke")
+    energy_law = _input(res, "wear_law") == "energy"
+    if energy_law:
+        k = _float(res, key.replace("wear_coefficient", "energy_wear_coefficient"))
+        k = None if k is None else k * 1e-3  # mm³/J → mm³/(N·mm)
+    work = h.get("wear_work")
+    blocks = h.get("block")
+    history = blocks is not None and len(np.unique(blocks)) > 1
+    if k is not None and work is not None and np.isfinite(work).all() and history and not energy_law:
+        ax.plot(n, k * work, color=line.get_color(), lw=0.8, alpha=0.6, ls=(0, (1, 2)),
+                label=f"Archard Σk·P·4δ·N over the blocks, {label}")
+    elif k is not None and work is not None and np.isfinite(work).all() and _input(res, "slip_model") == "coulomb":
+        ax.plot(n, k * work, color=line.get_color(), lw=0.8, alpha=0.6, ls=(0, (1, 2)),
+                label=f"{'α·ΣW' if energy_law else 'k·Σp|ds|A'}, {label}")
+    elif None not in (k, load, stroke) and not energy_law:
+        archard = k * load * 4 * stroke * 1e-3 * n
+        ax.plot(n, archard, color=line.get_color(), lw=0.8, alpha=0.6, ls=(0, (1, 2)),
+                label=f"Archard k·P·4δ·N, {label}")
+
+
+def _time_axis(ax, time: tuple) -> None:
+    """Time of continuous fretting below the panel, the cycles (the data's own axis) moved above it."""
+    frequency, unit, per = time
+    ax.xaxis.tick_top()
+    ax.xaxis.set_label_position("top")
+    below = ax.secondary_xaxis("bottom", functions=(lambda c: np.asarray(c) / per, lambda t: np.asarray(t) * per))
+    below.set_xlabel(f"time of continuous fretting at {frequency:g} Hz ({unit})")
+
+
 MAX_BLOCK_LINES = 60  # beyond, the boundaries would be a grey wash: said in the legend instead
 
 
-def _mark_blocks_and_limit(res: Results, axes) -> None:
-    """A load history's block boundaries (thin vertical lines), and a wear limit reached (its cycle, and its value
-    on the axis that shows it)."""
+def _mark_blocks(res: Results, axes) -> None:
+    """A load history's block boundaries (thin vertical lines)."""
     h = res.history
     blocks = h.get("block")
     if blocks is not None and len(np.unique(blocks)) > 1:
@@ -664,16 +796,58 @@ def _mark_blocks_and_limit(res: Results, axes) -> None:
                 ax.axvline(c, color="0.6", lw=0.6, ls="--", label="block boundaries" if i == 0 else None)
             if len(ends) > MAX_BLOCK_LINES:
                 ax.plot([], [], " ", label=f"{len(ends) + 1} load blocks (boundaries not drawn)")
-    s = res.summary
-    key = s.get("limit_reached")
-    if key:
-        n = float(s["cycles_to_limit"])
-        for ax in axes:
-            ax.axvline(n, color="C3", lw=1.0, label=f"{key} limit reached, N = {n:,.0f}")
-        depth_limits = res.depth_limits()
-        if key.startswith("max_wear_depth") and key in depth_limits:
-            um, text = depth_limits[key]
-            axes[0].axhline(um, color="C3", lw=0.8, ls=":", label=f"limit {text}")
+
+
+LIMIT_OFF_SCALE = 2.0  # a limit not reached is drawn up to this many times the panel's data; beyond, only named
+
+
+def _limit_on_panel(res: Results, key: str, value: float) -> Optional[tuple[str, float, str]]:
+    """(the history entry beside which a wear limit is drawn, the limit in that entry's unit, its legend text),
+    or None for a limit no panel shows (centre-line depths, scar widths) or a tube's wall the file lacks."""
+    from fretsim.quantities import WEAR
+    if key == "wall_loss":
+        outer, inner = _float(res, "geometry_outer_radius"), _float(res, "geometry_inner_radius")
+        if outer is None or inner is None:
+            return None
+        depth = value * (outer - inner) * 1e3
+        return ("max_wear_depth_moving", depth,
+                f"limit wall_loss: {value * 100:.3g} % of the {outer - inner:.3g} mm wall ({depth:.4g} µm)")
+    if key not in ("max_wear_depth_moving", "max_wear_depth_stationary", "wear_volume_moving",
+                   "wear_volume_stationary"):
+        return None
+    shown = value * WEAR[key].factor
+    return key, shown, f"limit {key}: {shown:.4g} {_unit(res, 'history/' + key)}"
+
+
+def _mark_limits(res: Results, axes, curves: dict, time: Optional[tuple]) -> None:
+    """Each of the case's wear limits as a horizontal line on the panel of its quantity (in that quantity's
+    colour; a limit far above what the run reached only named), and where the run stopped at one: a vertical
+    line through both panels, labelled with the cycle (and time), and a ring where the quantity meets its limit.
+    The label is the legend's: wear grows, so the stop's neighbourhood holds the curves' ends and no room."""
+    reached = res.summary.get("limit_reached") or ""
+    limits = res.wear_limits()
+    for key, (value, _) in limits.items():
+        on_panel = _limit_on_panel(res, key, value)
+        if on_panel is None:
+            continue
+        name, level, text = on_panel
+        line = curves[name]
+        ax = line.axes
+        ys = [np.asarray(c.get_ydata(), float) for c in curves.values() if c.axes is ax]
+        top = max((float(np.nanmax(y)) for y in ys if np.isfinite(y).any()), default=0.0)
+        if key == reached or level <= LIMIT_OFF_SCALE * top:
+            ax.axhline(level, color=line.get_color(), lw=1.2, ls=(0, (4, 2)), label=text)
+        else:
+            ax.plot([], [], " ", label=f"{text}, above the scale")
+    if not reached:
+        return
+    n = float(res.summary["cycles_to_limit"])
+    when = _cycles_label(round(n)) + (f", {_duration(n / time[2], time[1])}" if time is not None else "")
+    for ax in axes:
+        ax.axvline(n, color="C3", lw=1.0, label=f"{reached} limit reached: {when}")
+    on_panel = _limit_on_panel(res, reached, limits[reached][0]) if reached in limits else None
+    if on_panel is not None:  # a ring where the quantity meets its limit
+        curves[on_panel[0]].axes.plot([n], [on_panel[1]], "o", mfc="none", mec="C3", ms=9, mew=1.5)
 
 
 def _loop_facts(res: Results) -> str:

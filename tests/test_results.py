@@ -451,18 +451,25 @@ def centre_row_of(res):
     return centre_line(res.fields["wear_depth_stationary"][-1])
 
 
-@pytest.mark.parametrize("dimension", ["2d", "3d"])
-def test_every_figure_draws_inside_its_canvas_and_the_slip_map_scales_from_stuck_to_the_stroke(tmp_path, dimension):
+@pytest.mark.parametrize("dimension", ["2d", "3d", "service"])
+def test_every_figure_draws_inside_its_canvas_and_the_slip_map_scales_from_stuck_to_the_stroke(tmp_path, dimension,
+                                                                                              request):
     """The 3D fretting figure's colorbar was counted as a second row of panels, which took the one-row bottom
-    margin away: its x labels fell off the canvas (4 px), and the history's x label lost its descenders."""
+    margin away: its x labels fell off the canvas (4 px), and the history's x label lost its descenders.  The
+    service run (a frequency, a wear limit, 13 recorded states) adds the history's cycles axis on top and the
+    profiles' legend column."""
     import matplotlib
     matplotlib.use("Agg")
     from fretsim.plotting import figures
-    path = tmp_path / "r.h5"
-    run(load_case(CASE, [f"model.dimension={dimension}", "loading.friction_coefficient=0.9", "loading.cycles=300",
-                         "output.snapshots=[0, 150, 300]", "grid.error_estimate=none"]), path)
-    drawn = figures(read_results(path))
-    assert {"fretting", "history", "wear_profiles"} <= set(drawn)
+    if dimension == "service":
+        drawn = figures(read_results(request.getfixturevalue("service_run")))
+        assert {"history", "wear_profiles", "pressure_profiles"} <= set(drawn)
+    else:
+        path = tmp_path / "r.h5"
+        run(load_case(CASE, [f"model.dimension={dimension}", "loading.friction_coefficient=0.9", "loading.cycles=300",
+                             "output.snapshots=[0, 150, 300]", "grid.error_estimate=none"]), path)
+        drawn = figures(read_results(path))
+        assert {"fretting", "history", "wear_profiles"} <= set(drawn)
     if dimension == "3d":  # the slip map's scale runs from stuck to the whole stroke (4δ = 100 µm), not the data's
         #                    0.5 % spread in gross slip
         mesh = drawn["fretting"].axes[2].collections[0]
@@ -507,4 +514,148 @@ def test_cycle_ticks_read_as_powers_of_ten_past_a_hundred_thousand(results_3d):
                                                                           "1.5×10⁹"]
     drawn = figures(read_results(results_3d), names=["history"])
     assert drawn["history"].axes[0].xaxis.get_major_formatter()(1e9, 0) == "10⁹"
+    _close(drawn)
+
+
+# --- the figures an engineer hands in (issue #33): time, the stop at a wear limit, the profiles on the way --------
+
+SERVICE = ROOT / "cases" / "tube_service_RT.yaml"
+SERVICE_SNAPSHOTS = [15_000_000 * i for i in range(13)]  # 0 … 1.8·10⁸, the wall limit falls just after
+
+
+@pytest.fixture(scope="session")  # per worker, once
+def service_run(tmp_path_factory):
+    """The shipped tube in service (30 Hz), stopped at 10 % of its wall (1.85·10⁸ cycles, 1 710 h: 2 s instead of
+    the 40 % limit's 20 s), 13 recorded states on the way, and limits on other quantities the run does not reach
+    (a depth and a volume that the history's panels show, a scar width that none does)."""
+    path = tmp_path_factory.mktemp("service") / "service.h5"
+    run(load_case(SERVICE, ["limits.wall_loss=10 %", "limits.max_wear_depth_stationary=20 um",
+                            "limits.wear_volume_moving=3 mm3", "limits.scar_width_stationary=10 mm",
+                            "grid.error_estimate=none", f"output.snapshots={SERVICE_SNAPSHOTS}"]), path)
+    return path
+
+
+def _at_frequency(res, hz: str):
+    """The same run read as if its case gave another loading.frequency (the physics does not depend on it)."""
+    import dataclasses
+    assert "frequency: 30.0 Hz" in res.case_yaml
+    return dataclasses.replace(res, case_yaml=res.case_yaml.replace("frequency: 30.0 Hz", f"frequency: {hz}"))
+
+
+def test_the_time_unit_is_minutes_below_an_hour_hours_below_a_year_and_years_from_one():
+    from fretsim.plotting import time_unit
+    hour, year = 30 * 3600, 30 * 3600 * 8766  # cycles at 30 Hz
+    assert time_unit(hour - 1, 30.0) == ("min", 30 * 60)
+    assert time_unit(hour, 30.0) == ("h", hour) and time_unit(year - 1, 30.0) == ("h", hour)
+    assert time_unit(year, 30.0) == ("years", year)
+
+
+@pytest.mark.parametrize("hz, unit, per", [("30 Hz", "h", 30 * 3600.0), ("5 Hz", "years", 5 * 3600.0 * 8766)],
+                         ids=["1710_hours", "1.17_years"])
+def test_with_a_frequency_the_history_reads_time_below_in_the_unit_of_the_runs_length_and_cycles_on_top(
+        service_run, hz, unit, per):
+    """The history's x axis was cycles only (a service life is asked in hours or years): time of continuous
+    fretting below, its unit and frequency in its label, and the cycles (the data's own axis) above."""
+    from fretsim.plotting import figures
+    res = _at_frequency(read_results(service_run), hz)
+    fig = figures(res, names=["history"])["history"]
+    fig.canvas.draw()
+    for ax in fig.axes[:2]:
+        below = [c for c in ax.child_axes if c.xaxis.get_label_position() == "bottom"]
+        assert len(below) == 1
+        assert below[0].get_xlabel() == f"time of continuous fretting at {hz} ({unit})"
+        assert np.allclose(below[0].get_xlim(), np.array(ax.get_xlim()) / per, rtol=1e-9)
+        ticks = [t.get_text() for t in below[0].get_xticklabels() if t.get_text()]
+        assert len(ticks) >= 3 and all(float(t.replace("−", "-").replace(" ", "")) >= -1e9 for t in ticks), ticks
+        # the cycles stay readable, above
+        assert ax.get_xlabel() == "cycles N (–)" and ax.xaxis.get_label_position() == "top"
+        top = [t.get_text() for t in ax.get_xticklabels(which="major") if t.get_visible() and t.get_text()]
+        assert "10⁸" in top and all(t.label2.get_visible() and not t.label1.get_visible()
+                                    for t in ax.xaxis.get_major_ticks())
+    _close({"history": fig})
+
+
+def test_a_run_stopped_at_a_wear_limit_marks_the_stop_and_draws_every_limit_beside_its_quantity(service_run):
+    """The stop was a vertical line labelled in cycles only, and only a depth limit had its line: the tube's wall
+    loss, a volume's limit and the limits not reached had none."""
+    from matplotlib.colors import to_rgb
+
+    from fretsim.plotting import figures
+    res = read_results(service_run)
+    s = res.summary
+    assert s["limit_reached"] == "wall_loss" and res.status == "complete"
+    n = s["cycles_to_limit"]
+    fig = figures(res, names=["history"])["history"]
+    depth, volume = fig.axes[:2]
+    colour = {(ax, ln.get_label()): to_rgb(ln.get_color()) for ax in (depth, volume) for ln in ax.lines}
+    hours = f"{n / 30 / 3600:,.0f}".replace(",", " ")
+    for ax in (depth, volume):  # the stop: at the crossing, labelled with its cycle and its time
+        stop = [ln for ln in ax.lines if ln.get_label().startswith("wall_loss limit reached")]
+        assert len(stop) == 1 and np.allclose(stop[0].get_xdata(), n)
+        assert stop[0].get_label() == f"wall_loss limit reached: N = {round(n):,}".replace(",", " ") + f", {hours} h"
+
+    def level(ax, key):
+        found = [ln for ln in ax.lines if ln.get_label().startswith(f"limit {key}")]
+        assert len(found) == 1, [ln.get_label() for ln in ax.lines]
+        assert np.ptp(found[0].get_ydata()) == 0.0  # horizontal
+        return float(found[0].get_ydata()[0]), to_rgb(found[0].get_color())
+
+    # each limit on the panel of its quantity, in that quantity's colour: the wall's 10 % of 1 mm as the tube's
+    # (the moving body's) depth, the flat's depth, the tube's volume; no panel shows a scar width
+    assert level(depth, "wall_loss") == (pytest.approx(100.0), colour[depth, "moving"])
+    assert level(depth, "max_wear_depth_stationary") == (pytest.approx(20.0), colour[depth, "stationary"])
+    assert level(volume, "wear_volume_moving") == (pytest.approx(3.0), colour[volume, "moving"])
+    assert not [ln for ax in fig.axes for ln in ax.lines if "scar_width" in ln.get_label()]
+    ring = [ln for ln in depth.lines if ln.get_marker() == "o" and len(ln.get_xdata()) == 1]
+    assert len(ring) == 1 and (ring[0].get_xdata()[0], ring[0].get_ydata()[0]) == pytest.approx((n, 100.0))
+    _close({"history": fig})
+
+
+def test_the_title_of_a_run_stopped_at_a_limit_says_where_it_stopped_not_the_upper_bound(service_run):
+    """Every figure's title said N = 5000000000 (loading.cycles, the upper bound) of a run stopped at 1.85·10⁸."""
+    from fretsim.plotting import title_block
+    res = read_results(service_run)
+    n = res.summary["cycles_to_limit"]
+    title = title_block(res)
+    cycles = f"{n:,.0f}".replace(",", " ")
+    hours = f"{n / 30 / 3600:,.0f}".replace(",", " ")
+    assert f"stopped at {cycles} cycles (limit wall_loss reached), {hours} h of continuous fretting at 30 Hz" in title
+    assert "5000000000" not in title and "N = " not in title, title
+    # a years-long run says years
+    assert f"{n / 5 / 3600 / 8766:.3g} years of continuous fretting at 5 Hz" in title_block(_at_frequency(res, "5 Hz"))
+
+
+def test_the_profiles_show_six_recorded_states_spread_over_the_record_light_to_dark_with_cycle_and_time(
+        service_run):
+    """Every recorded state was drawn, in the default colour cycle, in a legend over the profiles: 13 states read
+    as a tangle.  Six now, the first and the last among them, light to dark, each labelled with its cycle and its
+    time, and the legend says how many of the recorded states it shows."""
+    from matplotlib.colors import to_rgb
+
+    from fretsim.measures import centre_line
+    from fretsim.plotting import figures
+    res = read_results(service_run)
+    cycles = res.fields["cycle"]
+    worn = np.flatnonzero(cycles > 0)
+    assert len(worn) == 13
+    drawn = figures(res, names=["wear_profiles", "pressure_profiles"])
+    fig = drawn["wear_profiles"]
+    expected = worn[[0, 2, 5, 7, 10, 12]]  # evenly over the 13: the first and the last among them
+    for ax, body in zip(fig.axes[:2], ("moving", "stationary")):
+        lines = [ln for ln in ax.lines if len(ln.get_xdata())]
+        assert len(lines) == 6
+        for ln, k in zip(lines, expected):
+            assert np.allclose(ln.get_ydata(), -centre_line(res.fields[f"wear_depth_{body}"][k]))
+        grey = [np.dot(to_rgb(ln.get_color()), (0.299, 0.587, 0.114)) for ln in lines]
+        assert all(a > b for a, b in zip(grey, grey[1:])), grey  # light to dark, in grey too
+    legend = next(ax.get_legend() for ax in fig.axes if ax.get_legend())
+    texts = [t.get_text() for t in legend.get_texts()]
+    last = res.fields["cycle"][-1]
+    hours = f"{last / 30 / 3600:,.0f}".replace(",", " ")
+    assert texts[0] == "N = 1.5×10⁷, 139 h" and texts[-1] == f"N = {last / 1e8:.3g}×10⁸, {hours} h"
+    assert len(texts) == 6 and legend.get_title().get_text() == "recorded states (6 of 13 shown)"
+    # the pressure profiles alike, from N = 0 (with Hertz's line)
+    legend = next(ax.get_legend() for ax in drawn["pressure_profiles"].axes if ax.get_legend())
+    assert len([t for t in legend.get_texts() if t.get_text().startswith("N = ")]) == 6
+    assert legend.get_title().get_text() == "recorded states (6 of 14 shown)"
     _close(drawn)

@@ -74,17 +74,35 @@ class Results:
             return {}
         return section if isinstance(section, dict) else {}
 
-    def depth_limits(self) -> dict:
-        """The case's wear limits on depths (key → (µm, as written)): what the history figure draws."""
+    def wear_limits(self) -> dict:
+        """The case's wear limits (key → (value in internal units: mm, mm³ or a fraction, as written)), those the
+        file's case states readably; what the history figure draws beside its quantities."""
+        from fretsim.quantities import WEAR
         from fretsim.units import UnitError, parse_quantity
         out = {}
         for key, written in self._case_section("limits").items():
-            if "wear_depth" in str(key):
-                try:
-                    out[key] = (parse_quantity(written, "length") * 1e3, str(written))
-                except UnitError:
-                    continue
+            wear = WEAR.get(str(key))
+            if wear is None:
+                continue
+            try:
+                value = float(written) if wear.kind == "fraction" else parse_quantity(written, wear.kind)
+            except (TypeError, ValueError, UnitError):
+                continue
+            if math.isfinite(value):
+                out[wear.key] = (value, f"{value:.3g}" if wear.kind == "fraction" else str(written))
         return out
+
+    def frequency(self) -> Optional[float]:
+        """The case's ``loading.frequency`` (Hz), or None where it gives none (or the file's case cannot say)."""
+        from fretsim.units import UnitError, parse_quantity
+        written = self._case_section("loading").get("frequency")
+        if written is None:
+            return None
+        try:
+            hz = parse_quantity(written, "frequency")
+        except UnitError:
+            return None
+        return hz if math.isfinite(hz) and hz > 0 else None
 
     def published(self) -> dict:
         """source (experiment, fea, paper) → (the flat's centre-line depth µm, its scar width mm) from the case's
