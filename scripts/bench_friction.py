@@ -44,8 +44,8 @@ def loop_seconds(tree: str, case: str, overrides: list[str]) -> float:
     return float(json.loads(out.stdout.strip().splitlines()[-1]))
 
 
-VERSUS = (("uniform, 3D", []), ("coulomb (mid-stroke), 2D", [MU, "model.slip=coulomb", "model.dimension=2d"]),
-          ("coulomb (mid-stroke), 3D", [MU, "model.slip=coulomb", "model.dimension=3d"]))
+VERSUS = (("uniform, 3D", []), ("coulomb (mid-stroke), 2D", [MU, "model.slip=coulomb", "model.stroke=mid_stroke", "model.dimension=2d"]),
+          ("coulomb (mid-stroke), 3D", [MU, "model.slip=coulomb", "model.stroke=mid_stroke", "model.dimension=3d"]))
 # with --resolved: the resolved stroke too, 3 pairs (a 3D pair takes about 3 minutes)
 RESOLVED = (("coulomb (resolved), 2D", [MU, "model.slip=coulomb", "model.stroke=resolved", "model.dimension=2d",
                                         "grid.error_estimate=none"]),
@@ -86,7 +86,7 @@ def main(quick: bool = False, baseline: str = "", vs_only: bool = False, resolve
     say("")
     say("McColl 185 N, μ = 0.9, 18 000 cycles: loop time (s, median of 3) and the flat's centre-line depth")
     say(f"{'model':<28}{'dim':<5}{'loop s':>9}{'solves':>8}{'depth µm':>10}  status")
-    for label, model in (("uniform", ["model.slip=uniform"]), ("coulomb (mid-stroke)", ["model.slip=coulomb"]),
+    for label, model in (("uniform", ["model.slip=uniform"]), ("coulomb (mid-stroke)", ["model.slip=coulomb", "model.stroke=mid_stroke"]),
                          ("coulomb, stroke resolved", ["model.slip=coulomb", "model.stroke=resolved"])):
         for dim in ("2d", "3d"):
             times, last = [], None
@@ -102,7 +102,7 @@ def main(quick: bool = False, baseline: str = "", vs_only: bool = False, resolve
     say("")
     say("increments per half-stroke against the depth error (against 65) and the loop time, 2D")
     chart = {}
-    for label, name, model in (("mid-stroke, McColl 185 N", "mccoll_185N", ["model.slip=coulomb"]),
+    for label, name, model in (("mid-stroke, McColl 185 N", "mccoll_185N", ["model.slip=coulomb", "model.stroke=mid_stroke"]),
                                ("resolved, McColl 500 N", "mccoll_500N", ["model.slip=coulomb",
                                                                            "model.stroke=resolved"])):
         points = []

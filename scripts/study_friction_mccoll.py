@@ -33,11 +33,11 @@ from fretsim.measures import centre_line  # noqa: E402
 
 OUT = ROOT / "scripts" / "out"
 CASES = ("mccoll_185N", "mccoll_500N", "mccoll_1670N", "mccoll_500N_10um")
-MODELS = {"uniform": ["model.slip=uniform"], "coulomb": ["model.slip=coulomb"],
+MODELS = {"uniform": ["model.slip=uniform"], "coulomb": ["model.slip=coulomb", "model.stroke=mid_stroke"],
           "coulomb, resolved": ["model.slip=coulomb", "model.stroke=resolved"]}
 # McColl's FE bodies: the flat a 12 × 6 mm block with the stroke at its base, the cylinder held 6 mm above the contact
 BODIES = ["geometry.flat_width=12 mm", "geometry.flat_thickness=6 mm", "geometry.moving_height=6 mm"]
-WITH_BODIES = {"coulomb, FE bodies": ["model.slip=coulomb", *BODIES],
+WITH_BODIES = {"coulomb, FE bodies": ["model.slip=coulomb", "model.stroke=mid_stroke", *BODIES],
                "resolved, FE bodies": ["model.slip=coulomb", "model.stroke=resolved", *BODIES]}
 
 
