@@ -664,8 +664,10 @@ def plot(results_files: tuple, outdir: Path | None, fmt: str, dpi: int, log_cycl
     pressure profiles with the initial Hertz solution, depth and volume against cycles.  Given several files
     (or --expected): one overlay.png of their worn profiles and depth histories on common axes, each run labelled
     by the values that differ between the runs.  Given a sweep's directory: response curves, each output against
-    each swept axis, one line per value of the others; for a sampled sweep, the depth band (P10–P90, P50) and the
-    histogram of the time to the wear limit with its P10, P50 and P90."""
+    each swept axis, one line per value of the others; for a sweep over loading.normal_load and loading.stroke
+    with a friction coefficient, in their place the fretting map (regime and wear over load × stroke, with δ_t),
+    the energy per cycle against stroke and chosen points' fretting loops; for a sampled sweep, the depth band
+    (P10–P90, P50) and the histogram of the time to the wear limit with its P10, P50 and P90."""
     if len(results_files) > 1 or expected:
         if any(p.is_dir() for p in results_files):
             raise Fail("overlaying takes results files, not a sweep's directory (plot that alone)")

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import math
 import os
+import re
 import textwrap
 import threading
 from pathlib import Path
@@ -927,7 +928,9 @@ SWEEP_OUTPUTS = ("centre_wear_depth_stationary_um", "max_wear_depth_moving_um", 
 
 def plot_sweep(table: SweepTable, outdir: str | Path, fmt: str = "png", dpi: int = 150) -> list[Path]:
     """Response curves: each output against each swept axis, one line per combination of the other axes; for a
-    sampled sweep, the uncertainty figures instead (:func:`uncertainty_bands`)."""
+    sampled sweep, the uncertainty figures instead (:func:`uncertainty_bands`); for a sweep over load and stroke
+    whose points judged their regime (a friction coefficient given), the fretting figures
+    (:func:`fretting_figures`) in place of the curves over those two axes."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     if table.mode == "sample":
@@ -935,37 +938,340 @@ def plot_sweep(table: SweepTable, outdir: str | Path, fmt: str = "png", dpi: int
     axes = list(table.axes)
     if not axes:
         raise ResultsFileError(f"{table.path}: the sweep has no axes (a list of points): nothing to draw curves over")
+    builders = {}
+    if is_fretting_sweep(table):
+        builders.update(fretting_figures(table, build=False))
+        axes = [a for a in axes if a not in FRETTING_AXES]
+    builders.update({f"sweep_{a.replace('.', '_')}": (lambda a=a: _response_curves(table, a)) for a in axes})
     paths = []
-    for axis in axes:
-        fig, ax_list = plt.subplots(1, len(SWEEP_OUTPUTS), figsize=(4.2 * len(SWEEP_OUTPUTS), 3.8), squeeze=False)
-        others = [a for a in axes if a != axis]
-        groups: dict = {}
-        for row in table.rows:
-            groups.setdefault(tuple(row.get(o, "") for o in others), []).append(row)
-        values = table.axes[axis]
-        for k, (key, rows) in enumerate(groups.items()):
-            order = {str(v): i for i, v in enumerate(_as_written(table, axis))}
-            rows = sorted(rows, key=lambda r: order.get(r.get(axis, ""), 0))
-            xs = [values[order[r[axis]]] if r.get(axis) in order else np.nan for r in rows]
-            label = ", ".join(f"{o.split('.')[-1]} = {v}" for o, v in zip(others, key)) or None
-            for ax, out in zip(ax_list[0], SWEEP_OUTPUTS):
-                ys = [float(r[out]) if r.get(out) not in (None, "") and r.get("status") == "complete" else np.nan
-                      for r in rows]
-                ax.plot(xs, ys, ls=STYLES[k % len(STYLES)], marker="o", ms=3, label=label)
-        for ax, out in zip(ax_list[0], SWEEP_OUTPUTS):
-            unit = table.units.get(axis, "")
-            ax.set_xlabel(f"{axis} ({unit})" if unit and unit != "1" else axis)
-            ax.set_ylabel(out.rsplit("_", 1)[0].replace("_", " ") + f" ({SUMMARY[out].unit.replace('um', 'µm')})")
-            ax.grid(alpha=0.3)
-        if groups and next(iter(groups)):
-            ax_list[0][0].legend(fontsize=7)
-        fig.suptitle(f"{Path(table.path).name}: response to {axis}", fontsize=10)
-        fig.tight_layout()
-        path = outdir / f"sweep_{axis.replace('.', '_')}.{fmt}"
-        _savefig(fig, path, dpi)
-        plt.close(fig)
+    for name, build in builders.items():
+        fig = build()
+        if fig is None:
+            continue
+        path = outdir / f"{name}.{fmt}"
+        try:
+            _savefig(fig, path, dpi)
+        finally:
+            plt.close(fig)
         paths.append(path)
     return paths
+
+
+def _response_curves(table: SweepTable, axis: str):
+    """Each output against ``axis``, one line per combination of the other axes."""
+    axes = list(table.axes)
+    fig, ax_list = plt.subplots(1, len(SWEEP_OUTPUTS), figsize=(4.2 * len(SWEEP_OUTPUTS), 3.8), squeeze=False)
+    others = [a for a in axes if a != axis]
+    groups: dict = {}
+    for row in table.rows:
+        groups.setdefault(tuple(row.get(o, "") for o in others), []).append(row)
+    values = table.axes[axis]
+    for k, (key, rows) in enumerate(groups.items()):
+        order = {str(v): i for i, v in enumerate(_as_written(table, axis))}
+        rows = sorted(rows, key=lambda r: order.get(r.get(axis, ""), 0))
+        xs = [values[order[r[axis]]] if r.get(axis) in order else np.nan for r in rows]
+        label = ", ".join(f"{o.split('.')[-1]} = {v}" for o, v in zip(others, key)) or None
+        for ax, out in zip(ax_list[0], SWEEP_OUTPUTS):
+            ys = [float(r[out]) if r.get(out) not in (None, "") and r.get("status") == "complete" else np.nan
+                  for r in rows]
+            ax.plot(xs, ys, ls=STYLES[k % len(STYLES)], marker="o", ms=3, label=label)
+    for ax, out in zip(ax_list[0], SWEEP_OUTPUTS):
+        unit = table.units.get(axis, "")
+        ax.set_xlabel(f"{axis} ({unit})" if unit and unit != "1" else axis)
+        ax.set_ylabel(out.rsplit("_", 1)[0].replace("_", " ") + f" ({SUMMARY[out].unit.replace('um', 'µm')})")
+        ax.grid(alpha=0.3)
+    if groups and next(iter(groups)):
+        ax_list[0][0].legend(fontsize=7)
+    fig.suptitle(f"{Path(table.path).name}: response to {axis}", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+# --- a sweep over load and stroke: the fretting map, the energy per cycle, the loops ------------------------------
+FRETTING_AXES = ("loading.normal_load", "loading.stroke")
+# the units a sweep file may write a load or a stroke in (fretsim.units.UNITS' force and length, a test keeps them
+# alike), to N and µm: this module reads the table's values as written and imports nothing but the results
+_TO_N = {"N": 1.0, "kN": 1e3, "MN": 1e6, "mN": 1e-3, "uN": 1e-6, "µN": 1e-6, "μN": 1e-6}
+_TO_UM = {"km": 1e9, "m": 1e6, "cm": 1e4, "mm": 1e3, "um": 1.0, "µm": 1.0, "μm": 1.0, "micron": 1.0, "microns": 1.0,
+          "nm": 1e-3}
+_AS_WRITTEN = re.compile(r"^\s*(?:±|\+/-)?\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?)\s*(\S+)\s*$")
+REGIMES = {"partial_slip": "partial slip", "gross_slip": "gross slip"}
+
+
+def _in_unit(text, scale: dict) -> float:
+    """A value as the sweep file wrote it ("185 N", "±0.5 um") in the unit of ``scale`` (1.0 there); NaN if not."""
+    m = _AS_WRITTEN.match(str(text))
+    return float(m.group(1)) * scale[m.group(2)] if m and m.group(2) in scale else math.nan
+
+
+def _row_number(row: dict, key: str) -> float:
+    try:
+        return float(row.get(key))
+    except (TypeError, ValueError):
+        return math.nan
+
+
+def fretting_points(rows: list) -> dict:
+    """The points of a load × stroke sweep as arrays: ``load`` (N), ``stroke`` (µm), ``status``, ``regime``,
+    ``assumed`` (no friction coefficient judged the regime: no δ_t), ``volume`` (the flat's wear, mm³), ``energy``
+    (J per cycle), ``q_star`` (N), ``d_t`` (δ_t of the unworn contact, µm) and ``point`` (the results file's
+    name), read from the table's rows."""
+    def column(key, kind=float):
+        return np.array([kind(r.get(key, "")) if kind is str else _row_number(r, key) for r in rows], dtype=kind)
+    pts = {"load": np.array([_in_unit(r.get(FRETTING_AXES[0]), _TO_N) for r in rows], dtype=float),
+           "stroke": np.array([_in_unit(r.get(FRETTING_AXES[1]), _TO_UM) for r in rows], dtype=float),
+           "status": column("status", str), "regime": column("regime", str), "point": column("point", str),
+           "volume": column("wear_volume_stationary_mm3"), "energy": column("dissipated_energy_per_cycle_J"),
+           "q_star": column("tangential_force_amplitude_N"), "d_t": column("gross_slip_stroke_um")}
+    pts["assumed"] = ~np.isfinite(pts["d_t"])
+    pts["done"] = pts["status"] == "complete"
+    return pts
+
+
+def is_fretting_sweep(table: SweepTable) -> bool:
+    """A sweep over load and stroke (both axes, every value a force and a length) whose complete points judged
+    their regime (a friction coefficient given: δ_t known): drawn as a fretting map."""
+    if table.mode == "sample" or not set(FRETTING_AXES) <= set(table.axes) or not table.rows:
+        return False
+    pts = fretting_points(table.rows)
+    finite = np.isfinite(pts["load"]) & np.isfinite(pts["stroke"]) & (pts["load"] > 0) & (pts["stroke"] > 0)
+    return bool(finite.all() and (pts["done"] & ~pts["assumed"]).any())
+
+
+def fretting_figures(table: SweepTable, build: bool = True) -> dict:
+    """A load × stroke sweep's figures, name → Figure (or, with ``build`` False, → a function drawing it, None where
+    there is nothing to draw): the fretting map, the energy per cycle against stroke, the loops of chosen points;
+    one set per combination of the other axes' values (named by them)."""
+    others = [a for a in table.axes if a not in FRETTING_AXES]
+    groups: dict = {}
+    for row in table.rows:
+        groups.setdefault(tuple(row.get(o, "") for o in others), []).append(row)
+    out = {}
+    for key, rows in groups.items():
+        said = ", ".join(f"{o.split('.')[-1]} = {v}" for o, v in zip(others, key))
+        suffix = "".join(f"_{o.split('.')[-1]}={v}" for o, v in zip(others, key)).replace(" ", "").replace("/", "_")
+        title = Path(table.path).name + (f" ({said})" if said else "")
+        pts = fretting_points(rows)
+        out[f"sweep_fretting_map{suffix}"] = lambda pts=pts, title=title: _fretting_map(pts, title)
+        out[f"sweep_fretting_energy{suffix}"] = lambda pts=pts, title=title: _fretting_energy(pts, title)
+        out[f"sweep_fretting_loops{suffix}"] = lambda pts=pts, title=title: _fretting_loops(table, pts, title)
+    if not build:
+        return out
+    return {name: fig for name, fig in ((n, b()) for n, b in out.items()) if fig is not None}
+
+
+def gross_slip_limits(pts: dict) -> tuple[np.ndarray, np.ndarray]:
+    """δ_t(P): each load's gross-slip stroke of the unworn contact (µm; the median over its complete points, which
+    agree to the grid's rounding) and the loads (N), ascending; loads without one left out."""
+    ok = pts["done"] & np.isfinite(pts["d_t"])
+    loads = np.unique(pts["load"][ok])
+    return np.array([np.median(pts["d_t"][ok & (pts["load"] == p)]) for p in loads]), loads
+
+
+def _wear_norm(values: np.ndarray):
+    """The map's colour scale: logarithmic over the positive wear (partial and gross slip differ by decades)."""
+    from matplotlib.colors import LogNorm, Normalize
+    pos = values[np.isfinite(values) & (values > 0)]
+    if not pos.size:
+        return Normalize(0.0, 1.0)
+    lo, hi = float(pos.min()), float(pos.max())
+    return LogNorm(lo / 1.1, hi * 1.1) if hi <= lo * 1.01 else LogNorm(lo, hi)
+
+
+# the map's markers by regime: label, selection, marker, filled
+def _map_classes(pts: dict) -> list:
+    done, assumed = pts["done"], pts["assumed"]
+    return [("partial slip", done & ~assumed & (pts["regime"] == "partial_slip"), "o", False),
+            ("gross slip", done & ~assumed & (pts["regime"] == "gross_slip"), "s", True),
+            ("gross slip, assumed (no μ)", done & assumed, "D", True),
+            ("not complete", ~done, "x", None)]
+
+
+def _fretting_map(pts: dict, title: str):
+    """The fretting map: each point at its stroke and load (log axes), its marker the regime (open circle: partial
+    slip, filled square: gross slip, diamond: gross slip assumed without μ, cross: not complete), its colour the
+    flat's wear volume; the gross-slip limit δ_t(P) through each load's δ_t (straight on log axes: interpolated
+    in log-log)."""
+    fig, ax = plt.subplots(figsize=(7.5, 5.6))
+    norm, cmap = _wear_norm(pts["volume"][pts["done"]]), plt.get_cmap("viridis")
+    for label, sel, marker, filled in _map_classes(pts):
+        if not sel.any():
+            continue
+        x, y, v = pts["stroke"][sel], pts["load"][sel], pts["volume"][sel]
+        colours = cmap(norm(np.where(np.isfinite(v) & (v > 0), v, norm.vmin)))
+        if filled is None:
+            ax.scatter(x, y, marker=marker, s=70, c="0.5", linewidths=1.5, label=label, zorder=3)
+        elif filled:
+            ax.scatter(x, y, marker=marker, s=90, c=colours, edgecolors="k", linewidths=0.8, label=label, zorder=3)
+        else:
+            ax.scatter(x, y, marker=marker, s=90, facecolors="none", edgecolors=colours, linewidths=2.2, label=label,
+                       zorder=3)
+    d_t, loads = gross_slip_limits(pts)
+    if loads.size:
+        ax.plot(d_t, loads, "k--" if loads.size > 1 else "k|", lw=1.3, ms=16, mew=1.5,
+                label="δ_t(P): gross slip beyond (unworn contact)")
+    xs = np.concatenate([pts["stroke"], d_t])
+    _log_axis(ax, "x", float(np.min(xs)), float(np.max(xs)), _swept(pts["stroke"]))
+    _log_axis(ax, "y", float(np.min(pts["load"])), float(np.max(pts["load"])), _swept(pts["load"]))
+    ax.set_xlabel("stroke δ, slip amplitude (µm)")
+    ax.set_ylabel("normal load P (N)")
+    ax.grid(alpha=0.3, which="both")
+    fig.colorbar(plt.cm.ScalarMappable(norm=norm, cmap=cmap), ax=ax, label="wear volume of the flat (mm³)")
+    ax.legend(fontsize=8, loc="upper center", bbox_to_anchor=(0.5, -0.13), ncol=2, frameon=False)
+    ax.set_title(f"{title}: fretting map, regime (marker) and the flat's wear (colour)", fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def _fretting_energy(pts: dict, title: str):
+    """The energy dissipated per cycle against stroke (log-log), one line per load, δ_t marked on each: Mindlin's
+    δ³ below δ_t (drawn through the smallest partial-slip stroke), the gross-slip line 4μP(δ − δ_e) above it (μP
+    the gross-slip points' Q*, δ_e their mean δ − E/4μP).  None where no point dissipated energy (no μ)."""
+    ok = pts["done"] & np.isfinite(pts["energy"]) & (pts["energy"] > 0)
+    if not ok.any():
+        return None
+    fig, ax = plt.subplots(figsize=(7.5, 5.0))
+    limits = dict(zip(*gross_slip_limits(pts)[::-1]))
+    said: set = set()
+    for i, p in enumerate(np.unique(pts["load"][ok])):
+        sel = np.flatnonzero(ok & (pts["load"] == p))
+        sel = sel[np.argsort(pts["stroke"][sel])]
+        x, e, colour = pts["stroke"][sel], pts["energy"][sel], f"C{i % 10}"
+        ax.plot(x, e, "o-", color=colour, lw=0.9, ms=6, label=f"P = {p:g} N")
+        d_t = limits.get(p, math.nan)
+        e_t = _energy_guides(ax, pts, sel, d_t, colour, said)  # δ_t on a guide, where the strokes do not reach it
+        if x[0] <= d_t <= x[-1]:
+            e_t = math.exp(np.interp(math.log(d_t), np.log(x), np.log(e)))
+        if e_t is not None:
+            ax.plot([d_t], [e_t], ls="none", marker="|", ms=20, mew=2.2, color=colour,
+                    label=_once(said, "δ_t of each load (unworn contact)"))
+    xs = np.concatenate([pts["stroke"][ok], [v for p, v in limits.items() if p in pts["load"][ok]]])
+    _log_axis(ax, "x", float(xs.min()), float(xs.max()), _swept(pts["stroke"][ok]))
+    ax.set_yscale("log")
+    ax.set_xlabel("stroke δ, slip amplitude (µm)")
+    ax.set_ylabel("energy dissipated per cycle (J)")
+    ax.grid(alpha=0.3, which="both")
+    handles, labels = ax.get_legend_handles_labels()  # the loads first, then what marks and guides them
+    order = sorted(range(len(labels)), key=lambda k: not labels[k].startswith("P = "))
+    ax.legend([handles[k] for k in order], [labels[k] for k in order], fontsize=8, loc="upper left")
+    ax.set_title(f"{title}: energy per cycle, partial slip ∝ δ³ (Mindlin), gross slip 4μP(δ − δ_e)", fontsize=9)
+    fig.tight_layout()
+    return fig
+
+
+def _once(said: set, label: str) -> str:
+    """``label`` the first time (for the legend), "_nolegend_" after."""
+    if label in said:
+        return "_nolegend_"
+    said.add(label)
+    return label
+
+
+def _energy_guides(ax, pts: dict, sel: np.ndarray, d_t: float, colour, said: set) -> Optional[float]:
+    """One load's references (dotted, dashed): δ³ through its smallest partial-slip stroke up to δ_t, and
+    4μP(δ − δ_e) from δ_t (or its smallest gross-slip stroke) to its largest stroke; returns the energy at δ_t on
+    them (the gross-slip line's, else the δ³'s; None if neither reaches δ_t)."""
+    at_limit = None
+    partial = sel[(pts["regime"][sel] == "partial_slip") & ~pts["assumed"][sel]]
+    if partial.size and np.isfinite(d_t):
+        x0, e0 = pts["stroke"][partial[0]], pts["energy"][partial[0]]
+        xs = np.geomspace(x0, max(d_t, x0), 100)
+        ax.plot(xs, e0 * (xs / x0) ** 3, ":", color=colour, lw=1.2, label=_once(said, "∝ δ³ (Mindlin), partial slip"))
+        at_limit = e0 * (d_t / x0) ** 3 if d_t >= x0 else None
+    gross = sel[(pts["regime"][sel] == "gross_slip") & ~pts["assumed"][sel] & np.isfinite(pts["q_star"][sel])]
+    if gross.size:
+        mu_p = float(np.median(pts["q_star"][gross]))  # in gross slip Q* = μP
+        x, e = pts["stroke"][gross], pts["energy"][gross]
+        d_e = float(np.mean(x - e / (4.0 * mu_p * 1e-6)))  # N·µm = 1e-6 J
+        start = d_t if np.isfinite(d_t) and d_e < d_t < x.min() else x.min()
+        xs = np.geomspace(start, x.max(), 100)
+        ax.plot(xs, 4.0 * mu_p * (xs - d_e) * 1e-6, "--", color=colour, lw=1.0,
+                label=_once(said, "4μP(δ − δ_e), gross slip (μP = Q*, δ_e fitted)"))
+        at_limit = 4.0 * mu_p * (d_t - d_e) * 1e-6 if start == d_t else at_limit
+    return at_limit
+
+
+def _loop_choice(pts: dict) -> tuple[float, list]:
+    """The load whose loops are drawn (most complete points; the middle one of those) and its points' indices:
+    the smallest stroke, the one nearest δ_t (in ratio), the largest."""
+    done = pts["done"]
+    loads, counts = np.unique(pts["load"][done], return_counts=True)
+    best = loads[counts == counts.max()]
+    load = float(best[len(best) // 2])
+    at = np.flatnonzero(done & (pts["load"] == load))
+    at = at[np.argsort(pts["stroke"][at])]
+    d_t = dict(zip(*gross_slip_limits(pts)[::-1])).get(load, math.nan)
+    chosen = [at[0]]
+    if np.isfinite(d_t) and d_t > 0:
+        chosen.append(at[np.argmin(np.abs(np.log(pts["stroke"][at] / d_t)))])
+    chosen.append(at[-1])
+    return load, sorted(dict.fromkeys(int(i) for i in chosen), key=lambda i: pts["stroke"][i])
+
+
+def _fretting_loops(table: SweepTable, pts: dict, title: str):
+    """The recorded fretting loops (the last recorded cycle) of the points :func:`_loop_choice` picks, force
+    against displacement, one panel each (their strokes differ by decades), each named by its stroke and regime;
+    ±μP dotted.  None where no point recorded a loop (uniform slip has none)."""
+    from fretsim.results import read_results
+    if not pts["done"].any():
+        return None
+    load, chosen = _loop_choice(pts)
+    drawn = []
+    for i in chosen:
+        try:
+            res = read_results(Path(table.path) / "points" / f"{pts['point'][i]}.h5")
+        except (OSError, ResultsFileError):
+            continue
+        loop = res.fretting_loop
+        if loop.get("displacement") is not None and loop["displacement"].size:
+            drawn.append((i, res))
+    if not drawn:
+        return None
+    fig, axes = plt.subplots(1, len(drawn), figsize=(4.4 * len(drawn), 4.6), squeeze=False)
+    for ax, (i, res) in zip(axes[0], drawn):
+        loop = res.fretting_loop
+        u, q = loop["displacement"][-1], loop["tangential_force"][-1]
+        ok = np.isfinite(u) & np.isfinite(q)
+        regime = REGIMES.get(str(pts["regime"][i]), str(pts["regime"][i])) + (" (assumed)" if pts["assumed"][i] else "")
+        name = f"δ = ±{pts['stroke'][i]:.3g} µm, {regime}"
+        ax.plot(u[ok], q[ok], "-", marker=".", ms=3, lw=1.3, label=f"{name} ({_cycles_label(loop['cycle'][-1])})")
+        mu = _float(res, "friction_coefficient")
+        if mu is not None:
+            for sign in (1, -1):
+                ax.axhline(sign * mu * load, color="k", ls=":", lw=0.9,
+                           label=f"±μP = ±{mu * load:.4g} N" if sign > 0 else "_nolegend_")
+        ax.set_xlabel(f"applied displacement ({_unit(res, 'fretting_loop/displacement')})")
+        ax.set_ylabel(f"tangential force Q ({_unit(res, 'fretting_loop/tangential_force')})")
+        ratio = pts["stroke"][i] / pts["d_t"][i] if np.isfinite(pts["d_t"][i]) and pts["d_t"][i] > 0 else None
+        ax.set_title(name + (f" ({ratio:.2g} δ_t)" if ratio else ""), fontsize=9)
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.15), frameon=False)
+    fig.suptitle(f"{title}: fretting loops at P = {load:g} N (each point's last recorded cycle)", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
+MAX_SWEPT_TICKS = 10  # swept values an axis labels each; beyond, the 1-2-5 ticks of log_ticks
+
+
+def _swept(values: np.ndarray) -> Optional[list]:
+    """The distinct swept values, as an axis's ticks (185 N, 0.3 µm read off the axis), if there are few."""
+    distinct = np.unique(values[np.isfinite(values) & (values > 0)])
+    return [float(v) for v in distinct] if 0 < distinct.size <= MAX_SWEPT_TICKS else None
+
+
+def _log_axis(ax, which: str, lo: float, hi: float, ticks: Optional[list] = None) -> None:
+    """A log axis over ``lo`` to ``hi`` (a quarter wider each side) with ticks that read: ``ticks`` if given, else
+    :func:`log_ticks` (1-2-5 within a decade or two, as powers of ten past 10⁵)."""
+    axis = ax.xaxis if which == "x" else ax.yaxis
+    getattr(ax, f"set_{which}scale")("log")
+    if ticks and (lo < ticks[0] / 2 or hi > ticks[-1] * 2):  # they would leave a stretch of the axis unlabelled
+        ticks = None
+    ticks = ticks or log_ticks(lo / 1.25, hi * 1.25)
+    getattr(ax, f"set_{which}lim")(min(lo / 1.25, ticks[0]), max(hi * 1.25, ticks[-1]))
+    getattr(ax, f"set_{which}ticks")(ticks)
+    axis.set_major_formatter(FuncFormatter(lambda v, _: _log_tick(v)))
+    axis.set_minor_formatter(plt.NullFormatter())
 
 
 BAND_POINTS = 200  # cycles at which the points' histories are read for the band
@@ -1154,12 +1460,7 @@ def _time_to_limit(table: SweepTable):
 def _limit_axis(ax, log: bool, lo: float, hi: float) -> None:
     """The time-to-limit axis: log ticks that read (1-2-5, as powers of ten past 10⁵), or cycles on a linear one."""
     if log:
-        ax.set_xscale("log")
-        ticks = log_ticks(lo / 1.25, hi * 1.25)
-        ax.set_xlim(min(lo / 1.25, ticks[0]), max(hi * 1.25, ticks[-1]))
-        ax.set_xticks(ticks)
-        ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: _log_tick(v)))
-        ax.xaxis.set_minor_formatter(plt.NullFormatter())
+        _log_axis(ax, "x", lo, hi)
     else:
         ax.xaxis.set_major_formatter(FuncFormatter(lambda v, _: cycles_tick(v)))
 

@@ -595,3 +595,193 @@ def test_a_sweep_whose_base_names_a_lone_surrogate_is_refused_before_any_point_r
     r = CliRunner().invoke(main, ["sweep", str(path), "-o", str(tmp_path / "out")])
     assert r.exit_code == 2 and "name: " in r.output and "lone surrogate" in r.output, r.output
     assert not (tmp_path / "out").exists()
+
+
+# --- a sweep over load and stroke with friction: the fretting map, the energy per cycle, the loops (issue 33) ------
+# McColl's cylinder in 2D at μ = 0.9: δ_t is 0.38 µm at 100 N and 0.67 µm at 185 N, so 0.3 µm is in partial slip
+# at both loads and 1 and 5 µm in gross slip.  Cheap: 100 cycles, the paper's grid, mid-stroke, no companion runs.
+FRETTING = f"""
+base: {CASES / 'mccoll_185N.yaml'}
+set: [model.dimension=2d, loading.friction_coefficient=0.9, model.stroke=mid_stroke, grid.rule=paper,
+      grid.error_estimate=none, loading.cycles=100, "output.snapshots=[0, 100]"]
+axes:
+  loading.normal_load: [100 N, 185 N]
+  loading.stroke: [0.3 um, 1 um, 5 um]
+"""
+# each point's grid rounds δ_t of the unworn contact its own way (measured 4e-5 apart at one load on the paper's grid)
+DELTA_T_ROUNDING = 2e-4
+
+
+@pytest.fixture(scope="session")
+def fretting_sweep(tmp_path_factory):
+    from fretsim.results import read_sweep_table
+    tmp = tmp_path_factory.mktemp("fretting")
+    out = tmp / "map"
+    assert run_sweep(load_sweep(sweep_file(tmp, FRETTING)), out, jobs=1).all_complete
+    return out, read_sweep_table(out)
+
+
+@pytest.fixture(scope="session")
+def fretting_drawn(fretting_sweep):
+    from fretsim.plotting import fretting_figures
+    return fretting_figures(fretting_sweep[1])
+
+
+def _fretting_rows(table):
+    """Each row's stroke (µm), load (N) and row, as the sweep file wrote them (in µm and N here)."""
+    return [(float(r["loading.stroke"].split()[0]), float(r["loading.normal_load"].split()[0]), r) for r in table.rows]
+
+
+def test_plotting_a_load_stroke_sweep_with_friction_draws_the_fretting_figures_not_response_curves(fretting_sweep,
+                                                                                                   tmp_path):
+    out, _ = fretting_sweep
+    r = CliRunner().invoke(main, ["plot", str(out), "-o", str(tmp_path / "figs")])
+    assert r.exit_code == 0, r.output
+    assert sorted(p.name for p in (tmp_path / "figs").iterdir()) == [
+        "sweep_fretting_energy.png", "sweep_fretting_loops.png", "sweep_fretting_map.png"]
+
+
+def test_the_fretting_map_puts_each_point_at_its_stroke_and_load_on_log_axes_marked_and_coloured(fretting_sweep,
+                                                                                                 fretting_drawn):
+    """One marker per point at (stroke, load), both axes logarithmic, grouped by regime into labelled markers
+    (open circles: partial slip, squares: gross slip), each coloured by the flat's wear volume on the colorbar."""
+    _, table = fretting_sweep
+    fig = fretting_drawn["sweep_fretting_map"]
+    ax, bar = fig.axes
+    assert (ax.get_xscale(), ax.get_yscale()) == ("log", "log")
+    assert ax.get_xlabel() == "stroke δ, slip amplitude (µm)" and ax.get_ylabel() == "normal load P (N)"
+    assert bar.get_ylabel() == "wear volume of the flat (mm³)"
+    rows = _fretting_rows(table)
+    assert {r["regime"] for _, _, r in rows} == {"partial_slip", "gross_slip"}  # the sweep spans δ_t
+    markers = {c.get_label(): c for c in ax.collections}
+    assert set(markers) == {"partial slip", "gross slip"}
+    from matplotlib.collections import QuadMesh
+    scale = next(c for c in bar.collections if isinstance(c, QuadMesh))  # the colorbar's colours: norm and map
+    for label, regime, colours_of in (("partial slip", "partial_slip", "get_edgecolor"),
+                                      ("gross slip", "gross_slip", "get_facecolor")):
+        want = {(s, p): float(r["wear_volume_stationary_mm3"]) for s, p, r in rows if r["regime"] == regime}
+        got = [tuple(xy) for xy in markers[label].get_offsets()]
+        assert sorted(got) == sorted(want)
+        colours = getattr(markers[label], colours_of)()
+        for xy, colour in zip(got, colours):
+            assert np.allclose(colour, scale.to_rgba(want[xy])), (label, xy)
+
+
+def test_the_fretting_map_boundary_runs_through_each_loads_gross_slip_stroke(fretting_sweep, fretting_drawn):
+    """δ_t(P) is drawn through each load's δ_t (its points' gross_slip_stroke_um), straight between them on the
+    log axes: interpolated in log-log."""
+    _, table = fretting_sweep
+    ax = fretting_drawn["sweep_fretting_map"].axes[0]
+    line, = [l for l in ax.get_lines() if l.get_label().startswith("δ_t(P)")]
+    assert list(line.get_ydata()) == [100.0, 185.0]
+    for d_t, load in zip(line.get_xdata(), line.get_ydata()):
+        points = [float(r["gross_slip_stroke_um"]) for _, p, r in _fretting_rows(table) if p == load]
+        assert len(points) == 3 and all(d_t == pytest.approx(v, rel=DELTA_T_ROUNDING) for v in points)
+    assert 0.3 < line.get_xdata()[0] < 1.0 and 0.3 < line.get_xdata()[1] < 1.0  # between the strokes, as the regimes
+
+
+def test_the_energy_per_cycle_is_drawn_against_stroke_on_log_axes_one_line_per_load_with_delta_t_marked(
+        fretting_sweep, fretting_drawn):
+    """Each load's line holds its points' dissipated_energy_per_cycle_J at their strokes (log-log, in J); δ_t is
+    marked on it; the gross-slip line 4μP(δ − δ_e) runs through the gross-slip points (E is linear in δ above δ_t:
+    its slope 4μP fixed by Q* = μP, only δ_e fitted) and the δ³ guide starts at the smallest partial-slip point."""
+    _, table = fretting_sweep
+    ax = fretting_drawn["sweep_fretting_energy"].axes[0]
+    assert (ax.get_xscale(), ax.get_yscale()) == ("log", "log")
+    assert ax.get_xlabel() == "stroke δ, slip amplitude (µm)" and ax.get_ylabel() == "energy dissipated per cycle (J)"
+    lines = {l.get_label(): l for l in ax.get_lines()}
+    limits = fretting_drawn["sweep_fretting_map"].axes[0].get_lines()[0]
+    for load, d_t in zip(limits.get_ydata(), limits.get_xdata()):
+        rows = sorted((s, float(r["dissipated_energy_per_cycle_J"]), r["regime"]) for s, p, r in _fretting_rows(table)
+                      if p == load)
+        line = lines[f"P = {load:g} N"]
+        assert list(line.get_xdata()) == [s for s, _, _ in rows] and list(line.get_ydata()) == [e for _, e, _ in rows]
+        colour = line.get_color()
+        marks = [l for l in ax.get_lines() if l.get_marker() == "|" and l.get_color() == colour]
+        assert len(marks) == 1 and marks[0].get_xdata()[0] == pytest.approx(d_t)
+        gross = [l for l in ax.get_lines() if l.get_linestyle() == "--" and l.get_color() == colour][0]
+        for s, e, regime in rows:
+            if regime == "gross_slip":  # measured within 1.4 %; a unit slip (mJ, N·mm) would be off by 10³
+                assert np.interp(s, gross.get_xdata(), gross.get_ydata()) == pytest.approx(e, rel=0.05)
+        cubic = [l for l in ax.get_lines() if l.get_linestyle() == ":" and l.get_color() == colour][0]
+        assert (cubic.get_xdata()[0], cubic.get_ydata()[0]) == (rows[0][0], rows[0][1])
+        assert cubic.get_xdata()[-1] == pytest.approx(d_t)
+    assert {"δ_t of each load (unworn contact)", "∝ δ³ (Mindlin), partial slip"} <= {
+        t.get_text() for t in ax.get_legend().get_texts()}
+
+
+def test_the_fretting_loops_are_the_recorded_loops_of_the_smallest_stroke_the_one_nearest_delta_t_and_the_largest(
+        fretting_sweep, fretting_drawn):
+    """At one load (185 N: both have all three points; the middle one): 0.3 µm, 1 µm (nearest δ_t = 0.67 µm) and
+    5 µm, each its own panel (their strokes differ by decades), force against displacement as its results file
+    recorded the loop at its last recorded cycle, named by its stroke and regime."""
+    out, table = fretting_sweep
+    fig = fretting_drawn["sweep_fretting_loops"]
+    assert "P = 185 N" in fig._suptitle.get_text()
+    rows = {s: r for s, p, r in _fretting_rows(table) if p == 185.0}
+    assert [ax.get_title().split(" (")[0] for ax in fig.axes] == [
+        "δ = ±0.3 µm, partial slip", "δ = ±1 µm, gross slip", "δ = ±5 µm, gross slip"]
+    for ax, stroke in zip(fig.axes, (0.3, 1.0, 5.0)):
+        loop = read_results(out / "points" / f"{rows[stroke]['point']}.h5").fretting_loop
+        u, q = loop["displacement"][-1], loop["tangential_force"][-1]
+        drawn = ax.get_lines()[0]
+        assert np.array_equal(drawn.get_xdata(), u[np.isfinite(u)]) and np.array_equal(drawn.get_ydata(),
+                                                                                      q[np.isfinite(q)])
+        assert ax.get_xlabel() == "applied displacement (µm)" and ax.get_ylabel() == "tangential force Q (N)"
+        assert drawn.get_label().startswith(ax.get_title().split(" (")[0])
+        assert f"±μP = ±{0.9 * 185:.4g} N" in [t.get_text() for t in ax.get_legend().get_texts()]
+
+
+def test_the_fretting_figures_lie_on_their_canvas_and_plot_no_wall_time(fretting_drawn):
+    from conftest import outside_canvas
+    assert set(fretting_drawn) == {"sweep_fretting_map", "sweep_fretting_energy", "sweep_fretting_loops"}
+    for name, fig in fretting_drawn.items():
+        assert outside_canvas(fig) is None, (name, outside_canvas(fig))
+        assert not any("wall" in ax.get_xlabel() + ax.get_ylabel() for ax in fig.axes), name
+
+
+def test_a_point_no_friction_coefficient_judged_is_marked_assumed_and_one_not_complete_is_crossed(fretting_sweep):
+    """The map's markers say where the regime was assumed (no δ_t: uniform slip without μ) and where a point did
+    not complete; neither moves the boundary, which only judged points draw."""
+    from fretsim.plotting import fretting_figures
+    from fretsim.results import SweepTable
+    _, table = fretting_sweep
+    rows = [dict(r) for r in table.rows]
+    assumed = next(r for r in rows if r["loading.stroke"] == "5 um" and r["loading.normal_load"] == "100 N")
+    assumed.update(gross_slip_stroke_um="nan", tangential_force_amplitude_N="nan")
+    failed = next(r for r in rows if r["loading.stroke"] == "1 um" and r["loading.normal_load"] == "185 N")
+    failed.update(status="failed", wear_volume_stationary_mm3="")
+    ax = fretting_figures(SweepTable(table.path, table.axes, table.units, rows))["sweep_fretting_map"].axes[0]
+    markers = {c.get_label(): [tuple(xy) for xy in c.get_offsets()] for c in ax.collections}
+    assert markers["gross slip, assumed (no μ)"] == [(5.0, 100.0)] and markers["not complete"] == [(1.0, 185.0)]
+    assert sorted(markers["gross slip"]) == [(1.0, 100.0), (5.0, 185.0)]
+    assert len([l for l in ax.get_lines() if l.get_label().startswith("δ_t(P)")][0].get_xdata()) == 2
+
+
+@pytest.mark.parametrize("dimension, scale, factor", [("length", "_TO_UM", 1e3), ("force", "_TO_N", 1.0)])
+def test_the_fretting_map_reads_loads_and_strokes_in_every_unit_a_case_accepts(dimension, scale, factor):
+    """The table keeps the values as the sweep file wrote them; the map reads them in µm and N with its own table
+    of units (plotting imports nothing but the results), which must know every unit the case reader does."""
+    import fretsim.plotting as plotting
+    from fretsim.units import UNITS
+    table = getattr(plotting, scale)
+    for unit, to_internal in UNITS[dimension].items():
+        assert plotting._in_unit(f"2.5 {unit}", table) == pytest.approx(2.5 * to_internal * factor, rel=1e-12), unit
+    assert plotting._in_unit("±0.5 um", plotting._TO_UM) == 0.5
+
+
+def test_a_delta_t_below_every_stroke_is_marked_on_the_gross_slip_line_within_the_axes(fretting_sweep):
+    """Where every stroke of a load slides (δ_t below them all), δ_t is still marked: on the gross-slip line
+    4μP(δ − δ_e) at δ_t, with the stroke axis widened to hold it (the map's axis likewise)."""
+    from fretsim.plotting import fretting_figures
+    from fretsim.results import SweepTable
+    _, table = fretting_sweep
+    rows = [r for r in table.rows if r["loading.stroke"] != "0.3 um"]
+    drawn = fretting_figures(SweepTable(table.path, table.axes, table.units, rows))
+    ax = drawn["sweep_fretting_energy"].axes[0]
+    limits = drawn["sweep_fretting_map"].axes[0].get_lines()[0]
+    for d_t in limits.get_xdata():
+        mark, = [l for l in ax.get_lines() if l.get_marker() == "|" and l.get_xdata()[0] == d_t]
+        gross, = [l for l in ax.get_lines() if l.get_linestyle() == "--" and l.get_color() == mark.get_color()]
+        assert gross.get_xdata()[0] == d_t and mark.get_ydata()[0] == pytest.approx(gross.get_ydata()[0], rel=1e-9)
+        assert ax.get_xlim()[0] < d_t
