@@ -544,13 +544,16 @@ def plot_overlay(results: list, outdir: str | Path, expected: bool = False, fmt:
 
 def published_profiles(panels: list, path: str | Path) -> Path:
     """A panel per case: a worn flat across the contact and its published depth and width as markers.
-    ``panels``: (title, x mm, depth µm, {source: (depth µm, width mm)}).  For the validation report."""
+    ``panels``: (title, x mm, depth µm, {source: (depth µm, width mm)}[, the moving body's depth µm]).  For the
+    validation report."""
     path = Path(path)
     cols = min(4, len(panels))
     rows = -(-len(panels) // cols)
     fig, axes = plt.subplots(rows, cols, figsize=(4 * cols, 3.2 * rows), squeeze=False)
-    for ax, (title, x, depth, published) in zip(axes.ravel(), panels):
-        ax.plot(x, [-v for v in depth], "C0-", label="fretsim")
+    for ax, (title, x, depth, published, *moving) in zip(axes.ravel(), panels):
+        ax.plot(x, [-v for v in depth], "C0-", label="fretsim" if not moving else "fretsim, flat")
+        if moving:
+            ax.plot(x, [-v for v in moving[0]], "C1--", label="fretsim, moving body")
         for source, (d, w) in published.items():
             m = EXPECTED_MARKERS.get(source, "x")
             if d is not None:

@@ -136,6 +136,7 @@ def run_one(args: tuple) -> dict:
         from fretsim.measures import centre_line
         row["profile_x_mm"] = out.setup.grid.x.tolist()
         row["profile_stationary_um"] = (centre_line(out.last.wear_stationary) * 1e3).tolist()
+        row["profile_moving_um"] = (centre_line(out.last.wear_moving) * 1e3).tolist()
     if out.last is not None and out.last.cycle == 0:
         g = out.setup.grid
         p = out.last.pressure
@@ -239,7 +240,7 @@ def build_report(cases: dict, results: dict, outdir: Path, quick: bool) -> str:
     lines += _table4_section(cases, results, outdir)
     lines += _friction_section(cases, results)
     lines += _table1_section(cases, results)
-    lines += _section4(cases, results)
+    lines += _section4(cases, results, outdir)
     lines += _table3_section(results)
     failed = [k for k, r in results.items() if r.get("status") != "complete"]
     if failed:
@@ -361,7 +362,7 @@ def _table1_section(cases: dict, results: dict) -> list[str]:
                     "√(5∫x²p/∫p) for the ball, which are a for Hertz's profiles; the paper's is Hertz's a.", ""]
 
 
-def _section4(cases: dict, results: dict) -> list[str]:
+def _section4(cases: dict, results: dict, outdir: Optional[Path] = None) -> list[str]:
     """Section 4, the practical applications: the paper's ratios between cases, and the cases it gives no
     numbers for."""
     ratio_cases = [(n, comp, r) for n, (_, e) in cases.items() if e for comp, r in e.ratios.items()]
@@ -385,9 +386,18 @@ def _section4(cases: dict, results: dict) -> list[str]:
                      f"{_fmt(s.get('max_wear_depth_moving_um'))} µm deep over {_fmt(s.get('scar_width_moving_mm'))} "
                      f"mm, flat {_fmt(s.get('max_wear_depth_stationary_um'))} µm over "
                      f"{_fmt(s.get('scar_width_stationary_mm'))} mm, in {res.get('seconds', float('nan')):.2f} s")
-    return lines + ["", "The paper prints no numbers for the wire rope and the seat rail, only figures; "
-                    "`python scripts/figures_section4.py` draws fretsim's counterparts of its Figs 21-22, 24-25 and "
-                    "27-28.", ""]
+    lines += ["", "The paper prints no numbers for the wire rope and the seat rail, only figures; "
+              "`python scripts/figures_section4.py` draws fretsim's counterparts of its Figs 21-22, 24-25 and 27-28.", ""]
+    scenes = [n for n in dict.fromkeys([*section4, *(m for n, o, _ in ratio_cases for m in (n, o))])
+              if n in results and results[n].get("profile_moving_um")]
+    if scenes and outdir is not None:
+        from fretsim.plotting import published_profiles
+        published_profiles([(f"{n} ({results[n].get('dimension', '?')})", results[n]["profile_x_mm"],
+                             results[n]["profile_stationary_um"], {}, results[n]["profile_moving_um"])
+                            for n in scenes], outdir / "section4.png")
+        lines += ["Each scene's worn profiles along y = 0 at the end of its run (fretsim, this run): the flat and the "
+                  "moving body (tube, rail, wire).", "", "![section 4](section4.png)", ""]
+    return lines
 
 
 def _table3_section(results: dict) -> list[str]:

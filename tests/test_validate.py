@@ -54,6 +54,18 @@ def test_quick_validation_reports_against_experiment_fea_and_paper_reading_each_
     assert max(profile) == pytest.approx(out["results"]["mccoll_185N"]["summary"]["centre_wear_depth_stationary_um"])
 
 
+def test_the_report_draws_the_section_4_scenes_worn_profiles_of_both_bodies(tmp_path):
+    """The paper gives the wire rope and the seat rail as figures only: the report shows fretsim's worn profiles
+    of both bodies for each section-4 scene (here the wire rope, quick), the moving body's from its own run."""
+    out = validate_module.validate(["wire_rope"], tmp_path / "v", jobs=1, quick=True)
+    assert out["ok"]
+    report = out["report"].read_text()
+    assert "![section 4](section4.png)" in report and (tmp_path / "v" / "section4.png").exists()
+    res = out["results"]["wire_rope"]
+    assert max(res["profile_moving_um"]) == pytest.approx(res["summary"]["centre_wear_depth_moving_um"])
+    assert len(res["profile_moving_um"]) == len(res["profile_x_mm"])
+
+
 def test_friction_validation_runs_each_cycle_model_with_the_fe_bodies_against_the_files_fea(tmp_path, monkeypatch):
     # the FEA value changed in a copy: the section and its MAPE must be computed from the file's number
     cases = tmp_path / "cases"
