@@ -121,8 +121,13 @@ def _percent(v: float) -> str:
     return f"{v * 100:.2g} %"
 
 
+def _shown(unit: str) -> str:
+    """A unit as the files write it (um, mm^3, mm3) as a figure shows it (µm, mm³)."""
+    return unit.replace("um", "µm").replace("mm^3", "mm³").replace("mm3", "mm³")
+
+
 def _unit(res: Results, key: str) -> str:
-    return res.units.get(key, "").replace("um", "µm").replace("mm^3", "mm³")
+    return _shown(res.units.get(key, ""))
 
 
 MAX_PROFILES = 6  # labelled profiles a panel draws at most: beyond, the legend and the colours stop reading
@@ -980,8 +985,8 @@ def _response_curves(table: SweepTable, axis: str):
             ax.plot(xs, ys, ls=STYLES[k % len(STYLES)], marker="o", ms=3, label=label)
     for ax, out in zip(ax_list[0], SWEEP_OUTPUTS):
         unit = table.units.get(axis, "")
-        ax.set_xlabel(f"{axis} ({unit})" if unit and unit != "1" else axis)
-        ax.set_ylabel(out.rsplit("_", 1)[0].replace("_", " ") + f" ({SUMMARY[out].unit.replace('um', 'µm')})")
+        ax.set_xlabel(f"{axis} ({_shown(unit)})" if unit and unit != "1" else axis)
+        ax.set_ylabel(out.rsplit("_", 1)[0].replace("_", " ") + f" ({_shown(SUMMARY[out].unit)})")
         ax.grid(alpha=0.3)
     if groups and next(iter(groups)):
         ax_list[0][0].legend(fontsize=7)

@@ -186,6 +186,16 @@ def test_response_curves_are_drawn_for_each_axis(local_sweep, tmp_path):
                                                                      "sweep_loading_stroke.png"]
 
 
+def test_response_curves_label_their_axes_in_micrometres_not_um(local_sweep):
+    from fretsim.plotting import _response_curves
+    from fretsim.results import read_sweep_table
+    _, out, _ = local_sweep
+    fig = _response_curves(read_sweep_table(out), "loading.stroke")
+    labels = [t for ax in fig.axes for t in (ax.get_xlabel(), ax.get_ylabel())]
+    assert "loading.stroke (µm)" in labels and any("(µm)" in t for t in labels[1::2]), labels
+    assert not any("(um)" in t for t in labels), labels
+
+
 def test_a_sweep_killed_mid_way_loses_no_completed_point_and_ends_with_the_same_table(tmp_path, local_sweep):
     _, reference, _ = local_sweep
     path = sweep_file(tmp_path)
