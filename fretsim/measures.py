@@ -63,3 +63,22 @@ def quantiles(values) -> np.ndarray:
     if np.isfinite(values).all():
         return np.percentile(values, PERCENTILES, method="linear")
     return np.array([np.quantile(values, q / 100, method="inverted_cdf") for q in PERCENTILES])
+
+
+def through_origin(x, y) -> tuple[float, float]:
+    """The slope of ``y`` against ``x`` by least squares through the origin, Σxy/Σx², and its scatter: the root
+    mean square of y/(slope·x) − 1 over the points with x > 0 (0 for points exactly on the line).  Fouvry's
+    energy wear coefficient α is the slope of the worn volume against the cumulative dissipated energy (Fouvry,
+    Kapsa & Vincent, Wear 1996); the scatter says how well one straight line holds.  (NaN, NaN) without a point
+    off x = 0; non-finite points take no part."""
+    x, y = np.asarray(x, dtype=float).ravel(), np.asarray(y, dtype=float).ravel()
+    ok = np.isfinite(x) & np.isfinite(y)
+    x, y = x[ok], y[ok]
+    sxx = float((x * x).sum())
+    if sxx <= 0:
+        return float("nan"), float("nan")
+    slope = float((x * y).sum()) / sxx
+    on = x > 0
+    if slope == 0:
+        return 0.0, 0.0 if not y[on].any() else float("nan")
+    return slope, float(np.sqrt(np.mean((y[on] / (slope * x[on]) - 1.0) ** 2)))

@@ -4,7 +4,8 @@ After the paper: wear profiles across the contact (Fig. 17) and, in 3D, along it
 with the initial Hertz solution; wear maps of both bodies, each on its own round colour scale (Figs. 24–25), and the pressure
 map (the finite cylinder's end peaks, Fig. 5); maximum depth and wear volume against cycles (Figs. 14, 28)
 with Archard's line and a marker at every contact solve, and against time where the case gives a frequency, with
-the load blocks, the wear limits and where the run stopped at one.  They read only the results file:
+the load blocks, the wear limits and where the run stopped at one; with friction, Fouvry's wear volume against
+the cumulative dissipated energy with the fitted energy wear coefficient α.  They read only the results file:
 :func:`figures` returns the matplotlib figures (tests check what is drawn), :func:`plot_all` saves them.
 """
 from __future__ import annotations
@@ -24,7 +25,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FuncFormatter, MaxNLocator  # noqa: E402
 
-from fretsim.measures import centre_line, quantiles  # noqa: E402
+from fretsim.measures import centre_line, quantiles, through_origin  # noqa: E402
 from fretsim.quantities import SUMMARY  # noqa: E402
 from fretsim.results import Results, ResultsFileError, SweepTable  # noqa: E402
 
@@ -248,6 +249,8 @@ def _builders(res: Results, log_cycles: bool) -> dict:
         out["maps"] = lambda: _maps(res)
     if res.fretting_loop.get("displacement") is not None and res.fretting_loop["displacement"].size:
         out["fretting"] = lambda: _fretting(res)
+    if _dissipates(res.history):  # a run with a friction coefficient (format 1.5 on)
+        out["energy_wear"] = lambda: _energy_wear(res)
     return out
 
 
@@ -930,21 +933,113 @@ def _fretting(res: Results):
     return fig
 
 
+ENERGY = "cumulative_dissipated_energy_J"
+BODIES = ("moving", "stationary")
+
+
+def _dissipates(history: dict) -> bool:
+    """Whether a history knows the energy its run dissipated, and some was: a run with a friction coefficient."""
+    energy = history.get(ENERGY)
+    return energy is not None and energy.size > 0 and bool(np.isfinite(energy).all()) and energy[-1] > 0
+
+
+def _scatter(v: float) -> str:
+    return "scatter –" if not np.isfinite(v) else f"scatter ±{_percent(v)}" if v >= 1e-4 else "scatter < 0.01 %"
+
+
+def _alpha_text(alpha: float, scatter: float) -> str:
+    """A fitted energy wear coefficient (mm³/J) and its scatter, as the legends say them."""
+    return f"α = {alpha:.4g} mm³/J, {_scatter(scatter)}"
+
+
+def _energy_wear(res: Results):
+    """Fouvry's energy approach: each body's wear volume against the energy dissipated by friction since cycle 0,
+    with α fitted by least squares through the origin (the case's α beside it under the energy law), and each
+    state's departure from the fitted line."""
+    h = res.history
+    energy = h[ENERGY]
+    on = energy > 0
+    law = _input(res, "wear_law") == "energy"
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.4))
+    for body, ls, colour in zip(BODIES, STYLES, ("C0", "C1")):
+        volume = h[f"wear_volume_{body}"]
+        alpha, scatter = through_origin(energy, volume)
+        given = _float(res, f"{body}_energy_wear_coefficient") if law else None
+        label = f"{body}: {_alpha_text(alpha, scatter)}" + (f" (the case's {given:.4g})" if given else "")
+        axes[0].plot(energy, volume, ls="none", marker="o", ms=3, color=colour, label=f"{body} body")
+        if np.isfinite(alpha):
+            axes[0].plot([0.0, energy[-1]], [0.0, alpha * energy[-1]], ls=ls, lw=1.0, color=colour, label=label)
+            if alpha > 0:
+                axes[1].plot(energy[on], (volume[on] / (alpha * energy[on]) - 1) * 100, ls=ls, marker="o", ms=3,
+                             color=colour, label=f"{body} body")
+    axes[0].set_ylabel(f"wear volume ({_unit(res, 'history/wear_volume_moving')})")
+    axes[0].ticklabel_format(axis="y", style="sci", scilimits=(-2, 3))  # 0.00150 mm³ took the label's room
+    axes[0].set_title("wear volume against dissipated energy (Fouvry)")
+    axes[1].axhline(0.0, color="k", lw=0.8)
+    axes[1].set_ylabel("V/(α·ΣE) − 1 (%)")
+    axes[1].set_title("each state off the fitted line")
+    for ax in axes:
+        ax.set_xlabel(f"cumulative dissipated energy ΣE ({_unit(res, 'history/' + ENERGY)})")
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8)
+    return fig
+
+
+def energy_wear_sweep(table: SweepTable):
+    """Fouvry's figure of a sweep: each complete point's wear volume against its cumulative dissipated energy
+    (its history a line, its end a marker), one panel a body, and α fitted through the origin over the points'
+    ends with its scatter; all on one line where the energy law holds across loads and strokes.  None where no
+    point dissipated energy (no friction coefficient, or files written before format 1.5)."""
+    from fretsim.results import read_results
+    rows = [r for r in table.rows if r.get("status") == "complete" and _finite(r.get("dissipated_energy_per_cycle_J"))
+            and float(r["dissipated_energy_per_cycle_J"]) > 0]
+    read = ((r, read_results(Path(table.path) / "points" / f"{r['point']}.h5").history) for r in rows)
+    points = [(r, h) for r, h in read if _dissipates(h)]
+    if not points:
+        return None
+    histories = [h for _, h in points]
+    fig, axes = plt.subplots(1, 2, figsize=(11, 4.6))
+    colours = state_colours(len(histories))
+    ends = np.array([h[ENERGY][-1] for h in histories])
+    named = len(points) <= MAX_PROFILES  # beyond, the legend stops reading: the points counted instead
+    labels = [", ".join(f"{a.split('.')[-1]} = {r.get(a, '')}" for a in table.axes) or r["point"] if named else
+              (f"each point's history ({len(points)} points)" if k == 0 else None) for k, (r, _) in enumerate(points)]
+    for ax, body in zip(axes, BODIES):
+        key = f"wear_volume_{body}"
+        for h, colour, label in zip(histories, colours, labels):
+            ax.plot(h[ENERGY], h[key], color=colour, lw=1.0, label=label)
+            ax.plot([h[ENERGY][-1]], [h[key][-1]], "o", color=colour, ms=4)
+        alpha, scatter = through_origin(ends, [h[key][-1] for h in histories])
+        if np.isfinite(alpha):
+            ax.plot([0.0, ends.max()], [0.0, alpha * ends.max()], "k--", lw=1.0,
+                    label=f"{_alpha_text(alpha, scatter)}\n(through the origin, over the points' ends)")
+        ax.set_xlabel("cumulative dissipated energy ΣE (J)")
+        ax.set_ylabel(f"wear volume, {body} body (mm³)")
+        ax.ticklabel_format(axis="y", style="sci", scilimits=(-2, 3))
+        ax.grid(alpha=0.3)
+        ax.legend(fontsize=8, loc="upper left")
+    fig.suptitle(f"{Path(table.path).name}: wear volume against dissipated energy (Fouvry)", fontsize=10)
+    fig.tight_layout()
+    return fig
+
+
 SWEEP_OUTPUTS = ("centre_wear_depth_stationary_um", "max_wear_depth_moving_um", "scar_width_stationary_mm",
                  "wall_time_s")
 
 
 def plot_sweep(table: SweepTable, outdir: str | Path, fmt: str = "png", dpi: int = 150) -> list[Path]:
     """Response curves: each output against each swept axis, one line per combination of the other axes; for a
-    sampled sweep, the uncertainty figures instead (:func:`uncertainty_bands`); for a sweep over load and stroke
-    whose points judged their regime (a friction coefficient given), the fretting figures
-    (:func:`fretting_figures`) in place of the curves over those two axes."""
+    sweep over load and stroke whose points judged their regime (a friction coefficient given), the fretting
+    figures (:func:`fretting_figures`) in place of the curves over those two axes; where the points dissipate
+    energy, Fouvry's figure (:func:`energy_wear_sweep`); for a sampled sweep, the uncertainty figures instead
+    (:func:`uncertainty_bands`)."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
     if table.mode == "sample":
         return uncertainty_bands(table, outdir, fmt, dpi)
     axes = list(table.axes)
-    if not axes:
+    fouvry = energy_wear_sweep(table)
+    if not axes and fouvry is None:
         raise ResultsFileError(f"{table.path}: the sweep has no axes (a list of points): nothing to draw curves over")
     builders = {}
     if is_fretting_sweep(table):
@@ -961,6 +1056,13 @@ def plot_sweep(table: SweepTable, outdir: str | Path, fmt: str = "png", dpi: int
             _savefig(fig, path, dpi)
         finally:
             plt.close(fig)
+        paths.append(path)
+    if fouvry is not None:
+        path = outdir / f"sweep_energy_wear.{fmt}"
+        try:
+            _savefig(fouvry, path, dpi)
+        finally:
+            plt.close(fouvry)
         paths.append(path)
     return paths
 

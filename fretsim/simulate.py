@@ -111,6 +111,7 @@ class Step:
     error_depth: float = 0.0  # the run's estimate of the relative depth error (accumulated)
     error_pressure: float = 0.0  # the run's estimate of the relative pressure error (L2) of this state
     work: float = 0.0  # the member's invariant accumulated to this cycle (volume = k·work), N·mm
+    energy: float = 0.0  # the energy dissipated by friction from cycle 0 to this one, N·mm (NaN: no μ)
     block: int = 0  # the loading's block whose cycles led to this state (0 at the start)
     limit: Optional[tuple] = None  # (key, crossing cycle, its interpolation spread): the wear limit reached here
     state: dict = field(default_factory=dict)  # the loop's checkpoint after this step (for resuming)
@@ -136,7 +137,10 @@ class _Loop:
 
     All of it goes into the checkpoint every emitted step carries (:mod:`fretsim.loop.checkpoint`).  Besides the
     wear, the loop carries ``work``: the member's invariant (volume = k·work) advanced by the same formulas as
-    the wear, so a broken spatial update shows as a volume off its invariant.
+    the wear, so a broken spatial update shows as a volume off its invariant; and ``energy``, the energy dissipated
+    by friction (Fouvry's abscissa), advanced by the same formulas again from each cycle's, so it is the sum over
+    the cycles the wear is, under any cycle jumping.  Where a cycle knows no energy (no friction coefficient) the
+    rate counts 0 and ``energy_known`` is cleared: what the loop reports from then on is NaN.
     """
 
     def __init__(self, setup: Setup, observers, progress):
@@ -160,14 +164,16 @@ class _Loop:
         self.p = self.p_prev = None
         self.r_m = self.r_s = None  # wear per cycle at the current state (the current cycle's)
         self.work = self.rate_work = 0.0  # accumulated invariant, and its rate per cycle at the current state
+        self.energy = self.rate_energy = 0.0  # dissipated energy accumulated (N·mm), and per cycle at the state
+        self.energy_known = 1  # 0 once a cycle without a friction coefficient counted (the checkpoint holds no NaN)
         self.memory: dict = {}  # the cycle model's own memory (its lagged slips)
         self.cyc: Optional[Cycle] = None
         self.d_prev = 1
         self.jump = 1.0
         self.lag = 0.0  # pressure lag per cycle of step (the last step's estimate / its length)
         self.err_abs_m = self.err_abs_s = 0.0  # accumulated local depth errors (mm, L2)
-        self.history: list = []  # implicit schemes: (N, φ_m, φ_s, p, φ_work)
-        self.batch: list = []  # adaptive scheme: (wear m, wear s, work) at the last linear steps
+        self.history: list = []  # implicit schemes: (N, φ_m, φ_s, p, φ_work, φ_energy)
+        self.batch: list = []  # adaptive scheme: (wear m, wear s, work, energy) at the last linear steps
         self.watch = GrowthWatch()
         self._summed = (None, None, None)  # (extra, compliance, their sum) of the last implicit solve
 
@@ -226,7 +232,9 @@ class _Loop:
         self.cyc = cyc
         self.p, self.r_m, self.r_s, self.memory = cyc.pressure, cyc.rate_moving, cyc.rate_stationary, cyc.memory
         self.rate_work = cyc.work
+        self.rate_energy = self.energy_rate(cyc)
         step = _record(s, self.n, self.h_m, self.h_s, cyc, self.work, self.t0 - self.elapsed)
+        step.energy = self.dissipated()
         step.jump, step.rejected = jump, self.rejected
         step.error_depth = max(_rel_scalar(self.err_abs_m, self.h_m), _rel_scalar(self.err_abs_s, self.h_s))
         step.error_pressure = error_pressure
@@ -264,17 +272,31 @@ class _Loop:
         """The current state as a step record, without stepping (a resumed run at its end)."""
         self.cyc = self.cyc or self.restored_cycle()
         step = _record(self.s, self.n, self.h_m, self.h_s, self.cyc, self.work, self.t0 - self.elapsed)
+        step.energy = self.dissipated()
         step.error_depth = max(_rel_scalar(self.err_abs_m, self.h_m), _rel_scalar(self.err_abs_s, self.h_s))
         step.block, step.limit, step.is_snapshot = self.block, self.reached, step.is_snapshot or bool(self.reached)
         step.state = checkpoint.state(self)
         return step
 
-    def advance(self, dh_m, dh_s, d_n: int, d_work: float) -> None:
+    def energy_rate(self, cyc: Cycle) -> float:
+        """The cycle's dissipated energy as the rate the loop accumulates (N·mm); 0 for a cycle that knows none,
+        which clears ``energy_known``."""
+        if np.isfinite(cyc.energy):
+            return float(cyc.energy)
+        self.energy_known = 0
+        return 0.0
+
+    def dissipated(self) -> float:
+        """The energy dissipated from cycle 0 to the current state (N·mm; NaN once a cycle knew none)."""
+        return self.energy if self.energy_known else float("nan")
+
+    def advance(self, dh_m, dh_s, d_n: int, d_work: float, d_energy: float) -> None:
         if (dh_m < 0).any() or (dh_s < 0).any():
             raise NumericalFailure(f"negative wear increment at cycle {self.n + d_n}", self.n)
         self.h_m = self.h_m + dh_m
         self.h_s = self.h_s + dh_s
         self.work = self.work + d_work
+        self.energy = self.energy + d_energy
         self.n += d_n
 
     def explicit_step(self, d_n) -> tuple[Cycle, float]:
@@ -282,7 +304,7 @@ class _Loop:
         with the pressure lag it leaves."""
         r_m, r_s = self.r_m, self.r_s
         p_old = self.p
-        self.advance(r_m * d_n, r_s * d_n, d_n, self.rate_work * d_n)
+        self.advance(r_m * d_n, r_s * d_n, d_n, self.rate_work * d_n, self.rate_energy * d_n)
         # predictor: extrapolate the pressure history so the warm start begins closer to the answer
         guess = p_old if self.p_prev is None else np.clip(p_old + (p_old - self.p_prev) * (d_n / self.d_prev), 0, None)
         cyc = self.cycle_at(self.n, guess)
@@ -300,7 +322,8 @@ class _Loop:
             cyc = self.cycle_at(0, None)
             checks.check_resolution(cyc.contact, s.solve_grid, s.y_edges_free)
             c = 0.5 if s.per_cycle else 0.0
-            self.history = [(0, c * cyc.rate_moving, c * cyc.rate_stationary, cyc.pressure, c * cyc.work)]  # φ = h + ½r
+            self.history = [(0, c * cyc.rate_moving, c * cyc.rate_stationary, cyc.pressure, c * cyc.work,
+                             c * self.energy_rate(cyc))]  # φ = h + ½r
             step = self.emit(cyc, 0)
         else:
             self.restore(resume)

@@ -244,3 +244,34 @@ def test_a_start_whose_top_of_the_search_is_beyond_the_plausible_range_is_search
              "materials.stationary.wear_coefficient=2e-7 1/MPa"]
     res = fit(CASE.read_text(), str(CASE), measured, keys=("materials.stationary.wear_coefficient",), overrides=start)
     assert res.low[0] <= K_STATIONARY <= res.high[0], (res.values, res.low, res.high, res.message)
+
+
+# --- 7. the energy law's α ------------------------------------------------------------------------------------------
+
+ENERGY = [TWO_D, "loading.friction_coefficient=0.9", "model.slip=coulomb", "model.stroke=mid_stroke",
+          "model.wear_law=energy", "materials.moving.energy_wear_coefficient=2e-5 mm3/J", "grid.error_estimate=none",
+          "loading.cycles=3000", "output.snapshots=[1000, 2000, 3000]"]
+ALPHA_STATIONARY = 3e-5  # mm³/J: the truth
+
+
+def test_fit_recovers_the_energy_laws_alpha_from_the_history_an_energy_run_exports(tmp_path):
+    """`--fit materials.stationary.energy_wear_coefficient` under `model.wear_law: energy`, started 2× high, finds
+    the α the measurements were made with from the run's exported history.csv at its recorded states (its
+    cumulative dissipated energy, not a wear quantity, noted and left out) within its interval."""
+    run(load_case(CASE, [*ENERGY, f"materials.stationary.energy_wear_coefficient={ALPHA_STATIONARY} mm3/J"]),
+        tmp_path / "truth.h5")
+    export_csv(read_results(tmp_path / "truth.h5"), tmp_path / "export")
+    header, *rows = (tmp_path / "export" / "history.csv").read_text().splitlines()
+    measured = tmp_path / "measured.csv"  # every step's row would be a snapshot of every trial run
+    measured.write_text("\n".join([header, *(r for r in rows if r.split(",")[0] in ("1000", "2000", "3000"))]) + "\n")
+    r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(measured),
+                                  *[a for s in ENERGY for a in ("--set", s)], "--set",
+                                  f"materials.stationary.energy_wear_coefficient={2 * ALPHA_STATIONARY} mm3/J",
+                                  "--fit", "materials.stationary.energy_wear_coefficient"])
+    assert r.exit_code == 0, r.output
+    note = next(line for line in r.output.splitlines() if line.startswith("note:") and "max_pressure" in line)
+    assert "cumulative_dissipated_energy_J" in note
+    found = re.search(r"materials.stationary.energy_wear_coefficient = (\S+) mm3/\(N\*mm\)  \(95 % CI \[(\S+) "
+                      r"mm3/\(N\*mm\), (\S+) mm3/\(N\*mm\)\]", r.output)
+    value, low, high = (float(v) * 1e3 for v in found.groups())  # mm³/(N·mm) → mm³/J
+    assert value == pytest.approx(ALPHA_STATIONARY, rel=0.01) and low <= ALPHA_STATIONARY <= high, r.output

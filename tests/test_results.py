@@ -3,6 +3,7 @@ import ast
 import csv
 import json
 import os
+import re
 import subprocess
 import sys
 import warnings
@@ -18,6 +19,7 @@ from fretsim.api import load_case, run
 from fretsim.case import parse_case
 from fretsim.cli import main
 from fretsim.results import read_results
+from fretsim.stepping import SCHEMES
 
 ROOT = Path(__file__).resolve().parent.parent
 CASE = ROOT / "cases" / "mccoll_185N.yaml"
@@ -253,12 +255,12 @@ def test_dimension_is_accepted_in_capitals():
 def test_a_format_1_1_file_is_still_read(results_3d, tmp_path):
     old = tmp_path / "v11.h5"
     old.write_bytes(results_3d.read_bytes())
-    with edited(old) as f:  # what the 1.1 writer made: none of 1.2's, 1.3's or 1.4's additions (its /choices had
-        #                     key, value, reason and given)
+    with edited(old) as f:  # what the 1.1 writer made: none of 1.2's, 1.3's, 1.4's or 1.5's additions (its /choices
+        #                     had key, value, reason and given)
         for path in ("inputs", "choices/error", "history/error_estimate_depth", "history/error_estimate_pressure",
                      "fields/x", "fields/y", "history/block", "history/dissipated_energy_J", "history/wear_work",
-                     "fields/slip_distance_moving", "fields/slip_distance_stationary", "fields/shear_traction",
-                     "fretting_loop"):
+                     "history/cumulative_dissipated_energy_J", "fields/slip_distance_moving",
+                     "fields/slip_distance_stationary", "fields/shear_traction", "fretting_loop"):
             if path in f:
                 del f[path]
         f.attrs["format_version"] = "1.1"
@@ -299,8 +301,8 @@ def test_a_version_older_than_the_file_never_switches_its_checksums_off(results_
         r = CliRunner().invoke(main, command)
         assert r.exit_code == 2 and "older than what the file holds" in r.output, (command, r.output)
     assert not (tmp_path / "p.png").exists() and not (tmp_path / "csv").exists()
-    with edited(path) as f:  # the 1.4 and 1.3 additions gone too: the checksums still hold it
-        del f["history/block"], f["fretting_loop"]
+    with edited(path) as f:  # the 1.5, 1.4 and 1.3 additions gone too: the checksums still hold it
+        del f["history/cumulative_dissipated_energy_J"], f["history/block"], f["fretting_loop"]
     r = CliRunner().invoke(main, ["summary", str(path)])
     assert r.exit_code == 2 and "checksum" in r.output, r.output
 
@@ -659,3 +661,119 @@ def test_the_profiles_show_six_recorded_states_spread_over_the_record_light_to_d
     assert len([t for t in legend.get_texts() if t.get_text().startswith("N = ")]) == 6
     assert legend.get_title().get_text() == "recorded states (6 of 14 shown)"
     _close(drawn)
+
+
+# --- Fouvry's energy approach (issue 33): the energy dissipated since cycle 0, and its figure -----------------------
+
+FRICTION_2D = ["model.dimension=2d", "loading.friction_coefficient=0.9", "grid.error_estimate=none"]
+ENERGY_LAW = ["model.slip=coulomb", "model.stroke=mid_stroke", "model.wear_law=energy",
+              "materials.moving.energy_wear_coefficient=2e-5 mm3/J",
+              "materials.stationary.energy_wear_coefficient=3e-5 mm3/J"]
+ALPHA = {"moving": 2e-5, "stationary": 3e-5}  # mm³/J, as set above
+# self-consistency: under the energy law the volume (α·Σ|q|·|ds|·A) and the cumulative energy (Σ|q|·|ds|·A) are
+# sums of the same increments, advanced by the same stepping formulas (measured 1e-15)
+SAME_SUMS = 1e-9
+CUMULATIVE = "cumulative_dissipated_energy_J"
+
+
+@pytest.fixture(scope="session")  # per worker, once
+def energy_run(tmp_path_factory):
+    """2D McColl 185 N, μ 0.9, Coulomb slip at mid-stroke, the energy law with α_m 2e-5 and α_s 3e-5 mm³/J."""
+    path = tmp_path_factory.mktemp("energy") / "energy.h5"
+    run(load_case(CASE, [*FRICTION_2D, *ENERGY_LAW, "loading.cycles=3000", "output.snapshots=[0, 1000, 3000]"]),
+        path)
+    return path
+
+
+def test_the_cumulative_energy_is_the_energy_per_cycle_times_the_cycles_through_cycle_jumps_and_nan_without_mu(
+        tmp_path):
+    """Uniform slip dissipates 4μPδ every cycle: the history's energy since cycle 0 is that times the cycle at every
+    step, across jumps of hundreds of cycles (not a trapezoid over the recorded steps), in J with a long name."""
+    path = tmp_path / "u.h5"
+    run(load_case(CASE, [*FRICTION_2D, "model.slip=uniform", "loading.cycles=3000"]), path)
+    h = read_results(path).history
+    per_cycle = 4 * 0.9 * 185.0 * 25e-3 * 1e-3  # 4μPδ: N·mm → J
+    assert np.diff(h["cycle"]).max() > 100
+    np.testing.assert_allclose(h[CUMULATIVE], per_cycle * h["cycle"], rtol=1e-12, atol=0)
+    with h5py.File(path, "r") as f:
+        assert f[f"history/{CUMULATIVE}"].attrs["units"] == "J"
+        assert "from cycle 0" in f[f"history/{CUMULATIVE}"].attrs["long_name"]
+    none = tmp_path / "n.h5"  # McColl's case gives no μ: no energy is known
+    run(load_case(CASE, ["model.dimension=2d", "grid.error_estimate=none", "loading.cycles=300"]), none)
+    assert np.isnan(read_results(none).history[CUMULATIVE]).all()
+
+
+@pytest.mark.parametrize("scheme", sorted(SCHEMES))
+def test_under_the_energy_law_each_bodys_volume_is_alpha_times_the_cumulative_energy_for_every_scheme(tmp_path,
+                                                                                                       scheme):
+    """Fouvry's law by construction: V = α·ΣE at every step, whatever the scheme's jumps (BDF2's and backward
+    Euler's implicit steps, linear jumps, the adaptive scheme's Taylor extrapolation), and ΣE lies between the
+    least and the most energy per cycle times the cycles."""
+    path = tmp_path / "e.h5"
+    run(load_case(CASE, [*FRICTION_2D, *ENERGY_LAW, "loading.cycles=2000", f"jumping.scheme={scheme}"]), path)
+    h = read_results(path).history
+    energy = h[CUMULATIVE]
+    assert energy[0] == 0.0 and (np.diff(energy) > 0).all()
+    for body, alpha in ALPHA.items():
+        np.testing.assert_allclose(h[f"wear_volume_{body}"], alpha * energy, rtol=SAME_SUMS, atol=0)
+    per_cycle = h["dissipated_energy_J"]
+    assert per_cycle.min() * 2000 <= energy[-1] <= per_cycle.max() * 2000
+
+
+def test_history_csv_and_to_xarray_carry_the_cumulative_energy_in_joules(energy_run, tmp_path):
+    from fretsim.export import export_csv
+    res = read_results(energy_run)
+    export_csv(res, tmp_path / "csv")
+    with open(tmp_path / "csv" / "history.csv", newline="") as fh:
+        rows = list(csv.DictReader(fh))
+    assert [float(r[f"{CUMULATIVE} [J]"]) for r in rows] == res.history[CUMULATIVE].tolist()
+    pytest.importorskip("xarray")
+    ds = res.to_xarray()
+    assert ds[CUMULATIVE].dims == ("step",) and ds[CUMULATIVE].attrs["units"] == "J"
+
+
+def test_fouvrys_figure_fits_the_energy_laws_alpha_through_the_origin_and_only_runs_with_friction_have_it(
+        energy_run, results_3d):
+    from fretsim.plotting import figures
+    res = read_results(energy_run)
+    drawn = figures(res)
+    fig = drawn["energy_wear"]
+    ax = fig.axes[0]
+    handles, labels = ax.get_legend_handles_labels()
+    energy = res.history[CUMULATIVE]
+    for body, alpha in ALPHA.items():
+        label = next(text for text in labels if text.startswith(f"{body}: α"))
+        assert float(re.search(r"α = (\S+) mm³/J", label).group(1)) == pytest.approx(alpha, rel=1e-3), label
+        assert "scatter < 0.01 %" in label and f"the case's {alpha:.4g}" in label
+        line = handles[labels.index(label)]  # the fitted line, through the origin to the last state
+        x, y = line.get_xdata(), line.get_ydata()
+        assert x[0] == y[0] == 0.0 and x[-1] == energy[-1]
+        assert y[-1] / x[-1] == pytest.approx(alpha, rel=SAME_SUMS)
+    assert outside_canvas(fig) is None, outside_canvas(fig)
+    _close(drawn)
+    without = figures(read_results(results_3d), names=["energy_wear"])  # McColl's case gives no μ
+    assert without == {}
+
+
+def test_a_format_1_4_file_without_the_cumulative_energy_is_still_read_plotted_and_exported(energy_run, tmp_path):
+    from fretsim.results import _seal
+    old = tmp_path / "v14.h5"
+    old.write_bytes(Path(energy_run).read_bytes())
+    with edited(old) as f:  # a 1.5 file claiming 1.4 is damage (its version was changed)
+        assert f.attrs["format_version"] == "1.5" and CUMULATIVE in f["history"]
+        f.attrs["format_version"] = "1.4"
+        _seal(f)
+    r = CliRunner().invoke(main, ["summary", str(old)])
+    assert r.exit_code == 2 and "older than what the file holds" in r.output, r.output
+    with edited(old) as f:  # what the 1.4 writer made
+        del f[f"history/{CUMULATIVE}"]
+        _seal(f)
+    res = read_results(old)
+    assert CUMULATIVE not in res.history and res.history["dissipated_energy_J"].size == res.history["cycle"].size
+    r = CliRunner().invoke(main, ["plot", str(old), "-o", str(tmp_path / "figs"), "--jobs", "1"])
+    assert r.exit_code == 0, r.output
+    assert {p.stem for p in (tmp_path / "figs").iterdir()} == {"v14_history", "v14_fretting", "v14_wear_profiles",
+                                                              "v14_pressure_profiles"}
+    r = CliRunner().invoke(main, ["export", str(old), "--csv", str(tmp_path / "csv")])
+    assert r.exit_code == 0, r.output
+    assert CUMULATIVE not in (tmp_path / "csv" / "history.csv").read_text().splitlines()[0]

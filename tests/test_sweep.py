@@ -795,3 +795,37 @@ def test_a_delta_t_below_every_stroke_is_marked_on_the_gross_slip_line_within_th
         gross, = [l for l in ax.get_lines() if l.get_linestyle() == "--" and l.get_color() == mark.get_color()]
         assert gross.get_xdata()[0] == d_t and mark.get_ydata()[0] == pytest.approx(gross.get_ydata()[0], rel=1e-9)
         assert ax.get_xlim()[0] < d_t
+
+
+FRICTION = f"""
+base: {CASES / 'mccoll_185N.yaml'}
+set: [model.dimension=2d, loading.friction_coefficient=0.9, model.slip=coulomb, model.stroke=mid_stroke,
+      loading.cycles=2000, "output.snapshots=[2000]", grid.error_estimate=none]
+axes:
+  loading.normal_load: [150 N, 250 N]
+  loading.stroke: [10 um, 40 um]
+"""
+
+
+def test_a_sweep_with_friction_puts_its_points_on_fouvrys_line_with_alpha_k_over_mu(tmp_path):
+    """Two loads by two strokes, Archard's law under Coulomb friction: where a point slides |q| = μp, so the energy
+    law holds with α = k/μ and every point's volume against its dissipated energy lies on one line through the
+    origin, whose slope the figure fits and names with its scatter."""
+    import re
+
+    import matplotlib.pyplot as plt
+
+    from fretsim.plotting import energy_wear_sweep
+    from fretsim.results import read_sweep_table
+    out = tmp_path / "o"
+    run_sweep(load_sweep(sweep_file(tmp_path, FRICTION)), out, jobs=1)
+    fig = energy_wear_sweep(read_sweep_table(out))
+    for ax, k in zip(fig.axes, (2e-8, 3e-8)):  # the case's k (1/MPa = mm³/(N·mm)), moving then stationary
+        labels = ax.get_legend_handles_labels()[1]
+        assert labels[:4] == [f"normal_load = {p} N, stroke = {d} um" for p in (150, 250) for d in (10, 40)]
+        alpha = float(re.search(r"α = (\S+) mm³/J, scatter < 0.01 %", labels[4]).group(1))
+        assert alpha == pytest.approx(k / 0.9 * 1e3, rel=1e-3)  # mm³/J
+    plt.close(fig)
+    r = CliRunner().invoke(main, ["plot", str(out), "-o", str(tmp_path / "figs")])
+    assert r.exit_code == 0, r.output
+    assert (tmp_path / "figs" / "sweep_energy_wear.png").exists()

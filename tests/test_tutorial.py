@@ -22,7 +22,8 @@ def test_the_tutorial_runs_as_written_and_produces_what_it_says(tmp_path):
                 r = subprocess.run(line, shell=True, cwd=tmp_path, capture_output=True, text=True, timeout=300)
                 assert r.returncode == 0, (line, r.stdout[-2000:], r.stderr[-2000:])
     for produced in ("ball.h5", "figures/ball_maps.png", "figures/ball_fretting.png", "figures/overlay.png",
-                     "sweep/table.csv", "sweep/table.h5", "sweep/figures/sweep_fretting_map.png",
+                     "figures/ball_energy_wear.png", "sweep/table.csv", "sweep/table.h5",
+                     "sweep/figures/sweep_fretting_map.png", "sweep/figures/sweep_energy_wear.png",
                      "csv/history.csv"):
         assert (tmp_path / produced).exists(), produced
     from fretsim.api import read_results

@@ -30,10 +30,11 @@ def enter_block(loop) -> None:
     loop.cyc = cyc
     loop.p, loop.r_m, loop.r_s, loop.memory = cyc.pressure, cyc.rate_moving, cyc.rate_stationary, cyc.memory
     loop.rate_work = cyc.work
+    loop.rate_energy = loop.energy_rate(cyc)
     c = 0.5 if s.per_cycle else 0.0
     loop.history = [(loop.n, loop.h_m + c * cyc.rate_moving, loop.h_s + c * cyc.rate_stationary, cyc.pressure,
-                     loop.work + c * cyc.work)]
-    loop.batch = [(loop.h_m, loop.h_s, loop.work)]
+                     loop.work + c * cyc.work, loop.energy + c * loop.rate_energy)]
+    loop.batch = [(loop.h_m, loop.h_s, loop.work, loop.energy)]
     loop.p_prev, loop.d_prev, loop.jump, loop.lag = None, 1, max(1.0, loop.jump * BLOCK_RESTART), 0.0
     loop.watch.reset()
 

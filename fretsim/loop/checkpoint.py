@@ -14,7 +14,8 @@ from fretsim.stability import GrowthWatch
 
 # the loop's own attributes, written as they are
 STATE = ("n", "h_m", "h_s", "p", "r_m", "r_s", "rate_work", "work", "jump", "rejected", "elapsed", "lag", "err_abs_m",
-         "err_abs_s", "p_prev", "d_prev", "block", "block_start", "work_bound")
+         "err_abs_s", "p_prev", "d_prev", "block", "block_start", "work_bound", "rate_energy", "energy",
+         "energy_known")
 
 
 def state(loop) -> dict:
@@ -24,9 +25,11 @@ def state(loop) -> dict:
     st["elapsed"] = loop.elapsed + time.perf_counter() - loop.t0
     st["batch"] = [a for b in loop.batch for a in b[:2]]  # flat list of arrays: m0, s0, m1, s1, ...
     st["batch_work"] = np.array([b[2] for b in loop.batch], dtype=float)
+    st["batch_energy"] = np.array([b[3] for b in loop.batch], dtype=float)
     st["history_n"] = np.array([h[0] for h in loop.history], dtype=np.int64)
     st["history"] = [a for h in loop.history for a in h[1:4]]  # φ_m, φ_s, p per point
     st["history_work"] = np.array([h[4] for h in loop.history], dtype=float)
+    st["history_energy"] = np.array([h[5] for h in loop.history], dtype=float)
     st["watch"] = np.array(loop.watch.history, dtype=float)
     st["scheme"] = loop.s.scheme
     if loop.s.wear_limits:
@@ -52,6 +55,8 @@ def restore(loop, st: dict) -> None:
     loop.jump, loop.elapsed, loop.lag = float(loop.jump), float(loop.elapsed), float(loop.lag)
     loop.err_abs_m, loop.err_abs_s = float(loop.err_abs_m), float(loop.err_abs_s)
     loop.work, loop.rate_work = float(loop.work), float(loop.rate_work)
+    loop.energy, loop.rate_energy = float(loop.energy), float(loop.rate_energy)
+    loop.energy_known = int(loop.energy_known)
     loop.memory = {k[len("memory_"):]: v for k, v in st.items() if k.startswith("memory_")}
     loop.block, loop.block_start = int(loop.block), int(loop.block_start)
     loop.work_bound = float(loop.work_bound)
@@ -86,9 +91,11 @@ def _restore_memory(loop, st: dict) -> None:
     """The stepping schemes' memory: the adaptive batch and the implicit schemes' history."""
     flat = list(st.get("batch", []))
     works = list(np.atleast_1d(st.get("batch_work", np.zeros(len(flat) // 2))))
-    loop.batch = [(flat[i], flat[i + 1], float(works[i // 2])) for i in range(0, len(flat), 2)]
+    energies = list(np.atleast_1d(st.get("batch_energy", np.zeros(len(flat) // 2))))
+    loop.batch = [(flat[i], flat[i + 1], float(works[i // 2]), float(energies[i // 2])) for i in range(0, len(flat), 2)]
     ns = [int(v) for v in np.atleast_1d(st.get("history_n", []))]
     arrays = list(st.get("history", []))
     hw = list(np.atleast_1d(st.get("history_work", np.zeros(len(ns)))))
-    loop.history = [(ns[i], arrays[3 * i], arrays[3 * i + 1], arrays[3 * i + 2], float(hw[i]))
+    he = list(np.atleast_1d(st.get("history_energy", np.zeros(len(ns)))))
+    loop.history = [(ns[i], arrays[3 * i], arrays[3 * i + 1], arrays[3 * i + 2], float(hw[i]), float(he[i]))
                     for i in range(len(ns))]

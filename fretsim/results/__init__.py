@@ -26,7 +26,8 @@ labelled.  Format 1.2 adds /inputs, /choices, the dimension scales, the summary 
 1.1; format 1.3 adds friction: the slip-distance and shear-traction fields, the dissipated energy and the
 invariant's work in the history, /fretting_loop, and the regime in the summary; format 1.4 adds load histories
 and wear limits: the block of every step in the history, and the summary's limit_reached, cycles_to_limit and
-time_to_limit_h.  1.1, 1.2 and 1.3 files are still read.
+time_to_limit_h; format 1.5 adds the cumulative dissipated energy to the history (Fouvry's abscissa).  1.1, 1.2,
+1.3 and 1.4 files are still read.
 
 Writing.  The writer keeps the run in memory and at every flush builds the whole file as an in-memory HDF5
 image, writes it with plain file I/O to a temporary file beside the target, fsyncs it and renames it over the

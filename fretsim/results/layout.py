@@ -3,8 +3,8 @@ from __future__ import annotations
 
 from fretsim.quantities import SUMMARY, WEAR
 
-FORMAT_VERSION = "1.4"
-READABLE_FORMATS = ("1.1", "1.2", "1.3", "1.4")
+FORMAT_VERSION = "1.5"
+READABLE_FORMATS = ("1.1", "1.2", "1.3", "1.4", "1.5")
 FLUSH_SECONDS = 0.5
 FLUSH_COST_FACTOR = 20.0  # flushes no more often than this many times their own cost (≤ ~5 % of the run)
 STATUSES = ("running", "complete", "interrupted", "failed", "stopped")
@@ -38,12 +38,16 @@ HISTORY = {
                   lambda s: s.work),
     "block": ("1", "the loading's block (from 0, in the order applied) whose cycles led to this state",
               lambda s: s.block),
+    "cumulative_dissipated_energy_J": ("J", "energy dissipated by friction from cycle 0 to this state: the per-cycle "
+                                            "energy summed over the cycles as the wear is, jumps included (NaN: no "
+                                            "friction coefficient)", lambda s: s.energy * 1e-3),
 }
 INTEGER_HISTORY = {"cycle", "solver_iterations", "cycle_jump", "rejected_steps", "block"}
-HISTORY_V11 = [k for k in HISTORY if not k.startswith("error_estimate") and k not in ("dissipated_energy_J",
-                                                                                        "wear_work", "block")]
-HISTORY_V12 = [k for k in HISTORY if k not in ("dissipated_energy_J", "wear_work", "block")]
-HISTORY_V13 = [k for k in HISTORY if k != "block"]
+NAN_HISTORY = {"dissipated_energy_J", "cumulative_dissipated_energy_J"}  # NaN without a friction coefficient
+HISTORY_V14 = [k for k in HISTORY if k != "cumulative_dissipated_energy_J"]
+HISTORY_V13 = [k for k in HISTORY_V14 if k != "block"]
+HISTORY_V12 = [k for k in HISTORY_V13 if k not in ("dissipated_energy_J", "wear_work")]
+HISTORY_V11 = [k for k in HISTORY_V12 if not k.startswith("error_estimate")]
 FIELDS = {
     "wear_depth_moving": ("um", "wear depth of the moving body", lambda s: s.wear_moving * 1e3),
     "wear_depth_stationary": ("um", "wear depth of the stationary body", lambda s: s.wear_stationary * 1e3),

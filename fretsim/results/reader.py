@@ -16,7 +16,8 @@ import numpy as np
 
 from fretsim.errors import ResultsFileError
 from fretsim.results.layout import (FIELDS, FIELDS_V12, FORMAT_VERSION, HISTORY, HISTORY_V11, HISTORY_V12, HISTORY_V13,
-                                    MAX_DATASET_BYTES, NAN_FIELDS, NAN_SUMMARY, READABLE_FORMATS, STATUSES)
+                                    HISTORY_V14, MAX_DATASET_BYTES, NAN_FIELDS, NAN_HISTORY, NAN_SUMMARY,
+                                    READABLE_FORMATS, STATUSES)
 from fretsim.results.seal import (SEALED_FROM, _SCALE_ATTRS, _Damaged, _verify_seal, checkpoint_digest, plain, text,
                                   verify_image)
 
@@ -250,6 +251,8 @@ def _read(f, path: str, for_resume: bool) -> Results:
 
 # what each format added that a file of an older one cannot hold: (test, its description)
 _FORMAT_MARKS = {
+    "1.5": (lambda f: isinstance(f.get("history"), h5py.Group) and "cumulative_dissipated_energy_J" in f["history"],
+            "/history/cumulative_dissipated_energy_J"),
     "1.4": (lambda f: isinstance(f.get("history"), h5py.Group) and "block" in f["history"], "/history/block"),
     "1.3": (lambda f: "fretting_loop" in f or _any_checksum(f), "/fretting_loop or the checksums of every object"),
     "1.2": (lambda f: "inputs" in f, "/inputs"),  # /choices is older: 1.1 wrote it
@@ -299,11 +302,10 @@ def _read_head(f, path: str) -> tuple[str, dict, str]:
 
 def _read_history(f, version: str, units: dict) -> dict:
     hist_group = _group(f, "history")
-    expected = (HISTORY if version >= "1.4" else HISTORY_V13 if version == "1.3" else HISTORY_V12 if version == "1.2"
-                else HISTORY_V11)
+    expected = {"1.1": HISTORY_V11, "1.2": HISTORY_V12, "1.3": HISTORY_V13, "1.4": HISTORY_V14}.get(version, HISTORY)
     history = {}
     for k in expected:
-        history[k] = _dataset(f, f"history/{k}", 1, allow_nan=k == "dissipated_energy_J")
+        history[k] = _dataset(f, f"history/{k}", 1, allow_nan=k in NAN_HISTORY)
         units[f"history/{k}"] = text(hist_group[k].attrs.get("units", ""))
     lengths = {v.shape[0] for v in history.values()}
     if len(lengths) > 1:

@@ -56,13 +56,14 @@ class Adaptive:
         and more than twice what it was) or whose solve fails is undone and retried at half the length
         (counted as rejected); below the linear jump it becomes a linear step.  The linear steps that follow
         damp what remains.  Jumps never end on a snapshot or the last cycle: those are reached by linear
-        steps, so recorded states are stabilised.  The invariant's work is extrapolated with the wear.
+        steps, so recorded states are stabilised.  The invariant's work and the dissipated energy are
+        extrapolated with the wear.
         """
         s = loop.s
         lin = s.linear_jump
         step = None
         if not loop.batch:
-            loop.batch = [(loop.h_m, loop.h_s, loop.work)]
+            loop.batch = [(loop.h_m, loop.h_s, loop.work, loop.energy)]
         while loop.n < s.cycles:
             loop.enter_block()
             room = loop.next_stop() - loop.n
@@ -73,7 +74,7 @@ class Adaptive:
             d_n = min(lin, room)
             cyc, e_p = loop.explicit_step(d_n)
             # a shortened step breaks the equal spacing the differences need: restart the batch
-            here = (loop.h_m, loop.h_s, loop.work)
+            here = (loop.h_m, loop.h_s, loop.work, loop.energy)
             loop.batch = loop.batch + [here] if d_n == lin else [here]
             step = loop.emit(cyc, d_n, e_p) or step
         return step
@@ -81,7 +82,7 @@ class Adaptive:
     def _jump(self, loop, lin: int, room: int, step):
         """A Taylor jump from the last batch, halved until it is accepted; (whether one was taken, the last step)."""
         s = loop.s
-        (m2, s2, w2), (m1, s1, w1), (m0, s0, w0) = loop.batch[-3:]
+        (m2, s2, w2, e2), (m1, s1, w1, e1), (m0, s0, w0, e0) = loop.batch[-3:]
         jump = min(taylor_jump([(m2, m1, m0), (s2, s1, s0)], lin, s.eta, s.max_jump or PAPER_MAX_JUMP),
                    room - Q_LINEAR * lin)
         before = abs(loop.watch.history[-1]) if loop.watch.history else 0.0
@@ -91,8 +92,9 @@ class Adaptive:
             if not ((new_m >= m0).all() and (new_s >= s0).all()):
                 jump //= 2  # the quadratic term must not make an increment negative
                 continue
-            saved = (loop.h_m, loop.h_s, loop.n, loop.work)
-            loop.advance(new_m - m0, new_s - s0, jump, taylor_extrapolate(w2, w1, w0, lin, jump) - w0)
+            saved = (loop.h_m, loop.h_s, loop.n, loop.work, loop.energy)
+            loop.advance(new_m - m0, new_s - s0, jump, taylor_extrapolate(w2, w1, w0, lin, jump) - w0,
+                         taylor_extrapolate(e2, e1, e0, lin, jump) - e0)
             try:
                 cyc = loop.cycle_at(loop.n, loop.p)
                 amp = abs(checkerboard_signed(cyc.contact.pressure))
@@ -100,14 +102,14 @@ class Adaptive:
             except NumericalFailure:
                 unstable = True
             if unstable:
-                loop.h_m, loop.h_s, loop.n, loop.work = saved
+                loop.h_m, loop.h_s, loop.n, loop.work, loop.energy = saved
                 loop.rejected += 1
                 jump //= 2
                 continue
             loop.p_prev = None
-            loop.batch = [(loop.h_m, loop.h_s, loop.work)]
+            loop.batch = [(loop.h_m, loop.h_s, loop.work, loop.energy)]
             loop.watch.reset()  # a jump is not a step of the linear sequence whose growth is watched
             step = loop.emit(cyc, jump, 0.5 * relative_change(cyc.pressure - loop.p, cyc.pressure)) or step
             return True, step
-        loop.batch = [(loop.h_m, loop.h_s, loop.work)]
+        loop.batch = [(loop.h_m, loop.h_s, loop.work, loop.energy)]
         return False, step

@@ -102,13 +102,14 @@ def _partner(history: list, d: int) -> Optional[int]:
 
 
 def _base(history: list, partner: Optional[int], d: int) -> tuple[tuple, float]:
-    """The step's known part of φ (moving, stationary, work) and γ: φ_{n+1} = base + γ·ΔN·r_{n+1}."""
-    _, phi_m, phi_s, _, phi_w = history[-1]
+    """The step's known part of φ (moving, stationary, work, energy) and γ: φ_{n+1} = base + γ·ΔN·r_{n+1}."""
+    _, phi_m, phi_s, _, phi_w, phi_e = history[-1]
     if partner is None:
-        return (phi_m, phi_s, phi_w), 1.0
-    n_k, k_m, k_s, _, k_w = history[partner]
+        return (phi_m, phi_s, phi_w, phi_e), 1.0
+    n_k, k_m, k_s, _, k_w, k_e = history[partner]
     b, g = bdf2_coefficients(d, history[-1][0] - n_k)
-    return (phi_m + b * (phi_m - k_m), phi_s + b * (phi_s - k_s), phi_w + b * (phi_w - k_w)), g
+    return (phi_m + b * (phi_m - k_m), phi_s + b * (phi_s - k_s), phi_w + b * (phi_w - k_w),
+            phi_e + b * (phi_e - k_e)), g
 
 
 def _accept(loop, cyc, d: int, partner: Optional[int], base: tuple, g: float, half: float) -> Optional[tuple]:
@@ -120,6 +121,8 @@ def _accept(loop, cyc, d: int, partner: Optional[int], base: tuple, g: float, ha
     p_new, r_m, r_s = cyc.pressure, cyc.rate_moving, cyc.rate_stationary
     new_phi_m, new_phi_s = base[0] + g * d * r_m, base[1] + g * d * r_s
     new_phi_w = base[2] + g * d * cyc.work
+    rate_e = loop.energy_rate(cyc)
+    new_phi_e = base[3] + g * d * rate_e
     h_m, h_s = new_phi_m - half * r_m, new_phi_s - half * r_s
     err_m, err_s, k_order = _local_errors(loop, partner, d, p_now, p_new, r_m, r_s, new_phi_m, new_phi_s, h_m, h_s)
     # a non-linear cycle: what its linearised implicit solve got wrong, counted in both bodies' errors
@@ -138,8 +141,9 @@ def _accept(loop, cyc, d: int, partner: Optional[int], base: tuple, g: float, ha
     loop.err_abs_m += err_m
     loop.err_abs_s += err_s
     loop.lag = e_p / d
-    loop.advance(h_m - loop.h_m, h_s - loop.h_s, d, new_phi_w - half * cyc.work - loop.work)
-    loop.history = (loop.history + [(loop.n, new_phi_m, new_phi_s, p_new, new_phi_w)])[-HISTORY_POINTS:]
+    loop.advance(h_m - loop.h_m, h_s - loop.h_s, d, new_phi_w - half * cyc.work - loop.work,
+                 new_phi_e - half * rate_e - loop.energy)
+    loop.history = (loop.history + [(loop.n, new_phi_m, new_phi_s, p_new, new_phi_w, new_phi_e)])[-HISTORY_POINTS:]
     return error, k_order, e_p
 
 
@@ -199,7 +203,8 @@ def _exact_cycle(loop):
     r_m, r_s = cyc.rate_moving, cyc.rate_stationary
     loop.jump, loop.lag = 2.0, e_p
     loop.history = (loop.history + [(loop.n, loop.h_m + 0.5 * r_m, loop.h_s + 0.5 * r_s, cyc.pressure,
-                                     loop.work + 0.5 * cyc.work)])[-HISTORY_POINTS:]
+                                     loop.work + 0.5 * cyc.work,
+                                     loop.energy + 0.5 * loop.energy_rate(cyc))])[-HISTORY_POINTS:]
     return loop.emit(cyc, 1, e_p)
 
 
