@@ -1595,10 +1595,14 @@ def _value_text(v: float, unit: str) -> str:
 
 
 def _as_written(table: SweepTable, axis: str) -> list:
+    """An axis's values as the sweep file wrote them (a product sweep's table.h5 keeps them with the axis); a zip
+    sweep's axis is its points' values, in their order."""
     import json
     import h5py
     with h5py.File(Path(table.path) / "table.h5", "r") as f:
-        return json.loads(f[axis].attrs["as_written"])
+        if axis in f and "as_written" in f[axis].attrs:
+            return json.loads(f[axis].attrs["as_written"])
+    return [r.get(axis, "") for r in table.rows]
 
 
 def grouped_bars(labels: list[str], panels: dict, path: str | Path, title: str, dpi: int = 130) -> Path:

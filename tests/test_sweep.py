@@ -196,6 +196,16 @@ def test_response_curves_label_their_axes_in_micrometres_not_um(local_sweep):
     assert not any("(um)" in t for t in labels), labels
 
 
+def test_a_zip_sweep_draws_its_response_curves(tmp_path):
+    """A zip sweep's table.h5 has no axis datasets (its points are the axis): plotting it raised KeyError."""
+    out = tmp_path / "zip"
+    assert run_sweep(load_sweep(sweep_file(tmp_path, SMALL + "mode: zip\n", "z.yaml")), out, jobs=1).all_complete
+    r = CliRunner().invoke(main, ["plot", str(out), "-o", str(tmp_path / "figs")])
+    assert r.exit_code == 0 and "Traceback" not in r.output, r.output
+    assert sorted(p.name for p in (tmp_path / "figs").iterdir()) == ["sweep_loading_normal_load.png",
+                                                                     "sweep_loading_stroke.png"]
+
+
 def test_a_sweep_killed_mid_way_loses_no_completed_point_and_ends_with_the_same_table(tmp_path, local_sweep):
     _, reference, _ = local_sweep
     path = sweep_file(tmp_path)
@@ -647,8 +657,8 @@ def test_plotting_a_load_stroke_sweep_with_friction_draws_the_fretting_figures_n
     out, _ = fretting_sweep
     r = CliRunner().invoke(main, ["plot", str(out), "-o", str(tmp_path / "figs")])
     assert r.exit_code == 0, r.output
-    assert sorted(p.name for p in (tmp_path / "figs").iterdir()) == [
-        "sweep_fretting_energy.png", "sweep_fretting_loops.png", "sweep_fretting_map.png"]
+    assert sorted(p.name for p in (tmp_path / "figs").iterdir()) == [  # and Fouvry's figure: the points dissipate
+        "sweep_energy_wear.png", "sweep_fretting_energy.png", "sweep_fretting_loops.png", "sweep_fretting_map.png"]
 
 
 def test_the_fretting_map_puts_each_point_at_its_stroke_and_load_on_log_axes_marked_and_coloured(fretting_sweep,
