@@ -167,3 +167,13 @@ def outside_canvas(fig) -> tuple | None:
     box = fig.get_tightbbox(fig.canvas.get_renderer()).transformed(fig.dpi_scale_trans)
     inside = box.x0 >= -0.5 and box.y0 >= -0.5 and box.x1 <= fig.bbox.width + 0.5 and box.y1 <= fig.bbox.height + 0.5
     return None if inside else (box.bounds, fig.bbox.bounds)
+
+
+@pytest.fixture(autouse=True)
+def _close_figures():
+    """Every test leaves pyplot as it found it: figures a test (or a session fixture it used) drew are closed after
+    it (a closed figure can still be inspected), so one worker never holds more than matplotlib warns about."""
+    yield
+    import sys
+    if "matplotlib.pyplot" in sys.modules:
+        sys.modules["matplotlib.pyplot"].close("all")
