@@ -71,8 +71,9 @@ def title_block(res: Results) -> str:
     elif res.inputs:
         parts.append(f"P = {_number(res, 'normal_load', '.4g')} N, δ = ±{_number(res, 'stroke', '.4g')} µm, "
                      f"{length}{_coefficients(res)}; "
-                     f"{str(_input(res, 'dimension', '')).upper()} {_input(res, 'geometry', '')}, gap "
-                     f"{_input(res, 'gap_model', '')}, {_input(res, 'scheme', '')}")
+                     f"{str(_input(res, 'dimension', '')).upper()} {_input(res, 'geometry', '')}, "
+                     + ("stroke resolved" if _input(res, "stroke_model") == "resolved" else  # the gap model unused
+                        f"gap {_input(res, 'gap_model', '')}") + f", {_input(res, 'scheme', '')}")
     if stop:
         parts.append(stop)
     if res.overrides:  # wrapped: a long --set line ran off the figure's top

@@ -481,6 +481,17 @@ def test_every_figure_draws_inside_its_canvas_and_the_slip_map_scales_from_stuck
     _close(drawn)
 
 
+def test_the_title_of_a_resolved_run_says_the_stroke_is_resolved_not_a_gap_model_it_does_not_use(tmp_path):
+    from fretsim.plotting import title_block
+    path = tmp_path / "r.h5"
+    sets = ["model.dimension=2d", "loading.friction_coefficient=0.9", "model.slip=coulomb", "model.stroke=resolved",
+            "loading.cycles=100", "output.snapshots=[0, 100]", "grid.error_estimate=none"]
+    r = CliRunner().invoke(main, ["run", str(CASE), "-o", str(path), *[a for s in sets for a in ("--set", s)]])
+    assert r.exit_code == 0, r.output
+    title = title_block(read_results(path))
+    assert "stroke resolved" in title and "gap mid_stroke" not in title, title
+
+
 def test_the_title_names_the_energy_laws_alpha_and_wraps_a_long_set_line_inside_the_canvas(tmp_path):
     """The energy law's figures showed Archard's k_m, k_s in their title (the law runs on α), and a long --set
     line ran off the figure's top."""
