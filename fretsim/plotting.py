@@ -1047,6 +1047,13 @@ def plot_sweep(table: SweepTable, outdir: str | Path, fmt: str = "png", dpi: int
         builders.update(fretting_figures(table, build=False))
         axes = [a for a in axes if a not in FRETTING_AXES]
     builders.update({f"sweep_{a.replace('.', '_')}": (lambda a=a: _response_curves(table, a)) for a in axes})
+    if fouvry is not None:
+        builders["sweep_energy_wear"] = lambda: fouvry
+    return _save_each(builders, outdir, fmt, dpi)
+
+
+def _save_each(builders: dict, outdir: Path, fmt: str, dpi: int) -> list[Path]:
+    """Build each figure (None: skipped), save it as OUTDIR/NAME.FMT and close it, whatever the save did."""
     paths = []
     for name, build in builders.items():
         fig = build()
@@ -1057,13 +1064,6 @@ def plot_sweep(table: SweepTable, outdir: str | Path, fmt: str = "png", dpi: int
             _savefig(fig, path, dpi)
         finally:
             plt.close(fig)
-        paths.append(path)
-    if fouvry is not None:
-        path = outdir / f"sweep_energy_wear.{fmt}"
-        try:
-            _savefig(fouvry, path, dpi)
-        finally:
-            plt.close(fouvry)
         paths.append(path)
     return paths
 
@@ -1426,15 +1426,8 @@ def uncertainty_figures(table: SweepTable) -> dict:
 
 def uncertainty_bands(table: SweepTable, outdir: Path, fmt: str = "png", dpi: int = 150) -> list[Path]:
     """Save :func:`uncertainty_figures` as OUTDIR/NAME.FMT."""
-    paths = []
-    for name, fig in uncertainty_figures(table).items():
-        path = Path(outdir) / f"{name}.{fmt}"
-        try:
-            _savefig(fig, path, dpi)
-        finally:
-            plt.close(fig)
-        paths.append(path)
-    return paths
+    return _save_each({name: (lambda fig=fig: fig) for name, fig in uncertainty_figures(table).items()}, Path(outdir),
+                      fmt, dpi)
 
 
 def _group_label(table: SweepTable, group: tuple) -> str:
