@@ -848,8 +848,8 @@ def _read_blocks(r: "_Reader", raw_load: dict, load: dict, given: list) -> tuple
     unset = [i for i, b in enumerate(out) if b.friction_coefficient is None]
     if unset and len(unset) < len(out):  # friction is resolved for the whole history or for none of it
         r.fail(f"loading.{kind}[{unset[0]}].friction_coefficient",
-               f"missing where other blocks give one: give it for every block (or loading.friction_coefficient, "
-               f"which the blocks take unless they give their own), or for none (the paper's gross slip)")
+               "missing where other blocks give one: give it for every block (or loading.friction_coefficient, "
+               "which the blocks take unless they give their own), or for none (the paper's gross slip)")
         return None, 1
     if spectrum:
         total = sum(b.fraction for b in out)
