@@ -288,7 +288,7 @@ class CoulombCycle:
         the contact still moves with its body.  Taking it as 0 there (the solver's slip) left a point that lost
         contact over the flat point where it left, so it re-entered the resolved stroke's contact reading the worn
         flat up to the stroke away from where it was: the moving body's profile went rough at element scale and
-        the contact rattled between its spikes, worse on every finer grid (scripts/results/resolved_travel.txt)."""
+        the contact rattled between its spikes, worse on every finer grid (scripts/results/resolved_convergence.txt)."""
         on = p > 0
         if self.rigid:
             return np.where(on, np.sign(du) * self.friction_coefficient * p, 0.0), np.full(p.shape, du), \

@@ -161,7 +161,7 @@ def choose_slip(case: Case, block: Block, transition: Optional[float]) -> Choice
                                               f"{case.accuracy:.1%}", error=deficit)
 
 
-def choose_stroke(case: Case, slip: str, regime_: Optional[Regime] = None, runs=None, plan_case=None) -> Choice:
+def choose_stroke(case: Case, slip: str, regime_: Regime, runs, plan_case) -> Choice:
     """mid_stroke (one normal solve per cycle, the paper's) or resolved (one per increment, at each position).
 
     auto: the paper's member keeps the paper's mid-stroke.  With friction resolved through the cycle, a pair of
@@ -178,9 +178,9 @@ def choose_stroke(case: Case, slip: str, regime_: Optional[Regime] = None, runs=
                                                          "wearing with its stroke average")
     held = ("Mindlin's setting: the normal contact at mid-stroke held through the cycle, each point's slip and "
             "traction resolved in increments")
-    if not case.loading.cycles or runs is None:
+    if not case.loading.cycles:
         return Choice("model.stroke", family.MID_STROKE, held + " (no wear: the stroke moves no worn surface)")
-    if regime_ is not None and regime_.transition is not None and all(
+    if regime_.transition is not None and all(
             b.stroke <= regime_.transition for b in case.loading.blocks if b.friction_coefficient is not None):
         return Choice("model.stroke", family.MID_STROKE, held + "; in partial slip the contact barely moves "
                                                                 "over the flat, resolving the stroke changes nothing")
@@ -207,11 +207,10 @@ def choose_stroke(case: Case, slip: str, regime_: Optional[Regime] = None, runs=
                   f"model.accuracy {case.accuracy:.2%} / {PROXY_MARGIN:g}", error=diff * PROXY_MARGIN)
 
 
-def build(case: Case, plan: Plan, grids, model, regime_: Regime, proxy_case: Optional[Case] = None, runs=None,
-          plan_case=None) -> Cycles:
+def build(case: Case, plan: Plan, grids, model, regime_: Regime, proxy_case: Case, runs, plan_case) -> Cycles:
     """The member and the stroke model recorded, then a member for each block of the loading."""
     slip = plan.add(regime_.slip)
-    stroke_model = plan.add(choose_stroke(proxy_case or case, slip, regime_, runs, plan_case))
+    stroke_model = plan.add(choose_stroke(proxy_case, slip, regime_, runs, plan_case))
     grid = grids.grid
     built: dict = {}  # a repeated block shares its member (and its cached operators)
 
