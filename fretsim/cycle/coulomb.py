@@ -218,7 +218,7 @@ class CoulombCycle:
                 q_high, p_high = q_new, p
             s, q = s + ds, q_new
             p_prev, ds_prev, du_prev = p, ds, du
-        if self.resolved and detail and not self.rigid:
+        if self.resolved and detail and not self.rigid and not corrected:  # (a corrected pass is not returned)
             tally.loop_u, tally.loop_q = turning_loop(self.stroke, fine, self._tangential, self._elastic_side,
                                                       (q_low, p_low), (q_high, p_high), tally.area)
         defect, mismatch = 0.0, None
