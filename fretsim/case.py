@@ -244,7 +244,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "preset": Key("choice", "paper: the DOE optimum η 0.55, ΔN_max 600, ΔN_L 55 (scaled to the grid's "
                                 "stability limit if needed)", None, choices=tuple(PRESETS))},
     "grid": {
-        "domain": Key("lengths", "[x, y] extents (one entry in 2D); automatic from the final scar if absent", None),
+        "domain": Key("lengths", "[x, y] extents (one entry in 2D); automatic from the final scar if absent (and then widened "
+                                   "during the run if the contact outgrows it)", None),
         "elements": Key("counts", "[Mx, My] elements; automatic (7a/40) if absent", None, lo=1, hi=100_000),
         "coarse_element": Key("lengths", "[dx, dy] of a coarse grid to solve the contact on (refinement, "
                                          "Eqs. 11–12)", None),

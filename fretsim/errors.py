@@ -34,7 +34,11 @@ class NumericalFailure(SimulationError):
 
 
 class DomainError(SimulationError):
-    """The contact outgrew the grid."""
+    """The contact outgrew the grid (``axis``: the edge it reached, 'x' or 'y')."""
+
+    def __init__(self, message: str, cycle: int, axis: str = "x"):
+        super().__init__(message, cycle)
+        self.axis = axis
 
 
 class ResolutionError(SimulationError):

@@ -4,6 +4,7 @@ The public face of this module is :mod:`fretsim.api`; sweeps (:mod:`fretsim.swee
 """
 from __future__ import annotations
 
+import dataclasses
 import math
 import signal
 import threading
@@ -14,14 +15,15 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from fretsim import grid_error
+from fretsim import grid_error, regrid
 from fretsim.case import GEOMETRY_KEYS, Case, CaseError, parse_case
 from fretsim.plan import Plan, SideRuns, estimate_cost, prepare, restore
 from fretsim.plan.cycle import strip_compliances
 from fretsim.reference import effective_modulus
 from fretsim.results import (OutputBusy, OutputClaim, Results, ResultsIOError, ResultsWriter, check_output_path,
                              read_results)
-from fretsim.simulate import (PhysicalLimit, ResolutionError, SimulationError, Setup, Step, simulate, summarize)
+from fretsim.simulate import (DomainError, PhysicalLimit, ResolutionError, SimulationError, Setup, Step, simulate,
+                              summarize)
 
 RESUMABLE = ("interrupted", "running")  # "running": the process was killed before it could say otherwise
 
@@ -206,13 +208,24 @@ class _Sink:
         self.output, self.setup, self.filled, self.plan = output, setup, filled, plan
         self.overwrite, self.previous, self.input_sha256 = overwrite, previous, input_sha256
         self.writer: Optional[ResultsWriter] = None
+        self.regrids: list = list(previous.regrids) if previous is not None else []  # the grid's widenings so far
+
+    def regrid(self, r, setup, filled, plan, state: dict) -> None:
+        """The run moves onto a widened grid, from ``state`` (the last step's, widened): so does what the results
+        file holds of it, its checkpoint included (a Ctrl-C before the next step resumes on the wider grid)."""
+        self.open(self.overwrite)  # a resumed run may widen before its first step: the file's snapshots go too
+        self.regrids.append(r)
+        self.setup, self.filled, self.plan = setup, filled, plan
+        if self.writer is not None:
+            self.writer.regrid(r, setup.grid, filled.to_yaml(), plan.choices, setup.notes)
+            self.writer.state = state
 
     def open(self, overwrite: bool) -> None:
         if self.writer is None and self.output is not None:
             self.writer = ResultsWriter(self.output, self.filled.to_yaml(), self.filled.name, self.setup.grid,
                                         self.setup.notes, overwrite, previous=self.previous,
                                         choices=self.plan.choices, inputs=inputs_of(self.filled),
-                                        input_sha256=self.input_sha256)
+                                        input_sha256=self.input_sha256, regrids=self.regrids)
 
     def on_step(self, setup_, step) -> None:
         self.open(self.overwrite)
@@ -264,14 +277,15 @@ def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from:
     state = resume_from.checkpoint if resume_from is not None else None
     output = sink.output
     try:
-        status, message = _simulate(setup, filled, plan, counter, sink, observers, progress, state)
+        status, message = _simulate(counter, sink, observers, progress, state, runs)
     except ResultsIOError as exc:
-        return _io_outcome(exc, sink, setup, filled, plan, counter, t0)
+        return _io_outcome(exc, sink, sink.setup, sink.filled, sink.plan, counter, t0)
     except KeyboardInterrupt:
         sink.finish_interrupted(counter, t0, lambda: f"interrupted after cycle "
                                 f"{counter.last.cycle if counter.last else (int(state['n']) if state else 0)}; "
                                 f"resume with `fretsim run --resume {output}`")
         raise
+    setup, filled, plan = sink.setup, sink.filled, sink.plan  # (on the grid the run ended on)
     if status == "complete" and counter.last is not None:
         _estimate_errors(setup, filled, plan, counter, sink, t0, runs)
     previous = _ignore_signals()  # a Ctrl-C in the last instant must not make a complete run look interrupted
@@ -285,16 +299,61 @@ def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from:
                    counter.last, tuple(setup.notes) + tuple(counter.notes), plan, sink.writer is not None)
 
 
-def _simulate(setup, filled, plan, counter, sink: _Sink, observers, progress, state) -> tuple[str, str]:
-    """The loop, its ending as a status and a message (a grid that cannot resolve the contact is bad input)."""
+def _simulate(counter, sink: _Sink, observers, progress, state, runs: SideRuns) -> tuple[str, str]:
+    """The loop, its ending as a status and a message (a grid that cannot resolve the contact is bad input); an
+    automatic grid the contact outgrows is widened and the loop goes on from its last step (:mod:`fretsim.regrid`)."""
+    while True:
+        try:
+            return _simulate_on(sink.setup, sink.plan, counter, sink, observers, progress, state)
+        except DomainError as exc:
+            state = _widen(exc, counter, sink, runs, state)
+            if state is None:
+                return "failed", str(exc)
+
+
+def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns, resumed: Optional[dict]) -> Optional[dict]:
+    """The last step's state (or the one the run was ``resumed`` from, before its first step) on a grid widened
+    where the contact reached its edge, the run's setup and its results file moved onto it; None where the grid
+    may not or cannot grow (the user's grid, too many widenings, nothing to go back to, a grid the planner
+    refuses), with the reason noted."""
+    setup, filled, plan = sink.setup, sink.filled, sink.plan
+    base = counter.last.state if counter.last is not None else resumed
+    if not regrid.grid_is_automatic(plan) or not base:
+        return None
+    if len(sink.regrids) >= regrid.MAX_REGRIDS:
+        counter.notes.append(f"the automatic grid was widened {regrid.MAX_REGRIDS} times, the most allowed: the "
+                             f"scar outgrew the planned one far beyond its estimate")
+        return None
+    r = regrid.widened(setup.grid, exc.axis, setup.band, int(base["n"]),
+                       f"the contact reached the {exc.axis} edge at cycle {exc.cycle}")
+    plane = setup.grid.plane_strain
+    wider = filled.with_choices(domain=r.new_domain[:1] if plane else r.new_domain,
+                                elements=r.new_elements[:1] if plane else r.new_elements)
+    try:
+        new_setup, new_filled, _ = prepare(wider, runs=runs)
+    except CaseError as err:  # e.g. more memory than the machine has
+        counter.notes.append(f"the automatic grid could not be widened: {str(err).splitlines()[-1][:200]}")
+        return None
+    state = regrid.pad_state(base, r)
+    if counter.last is not None:
+        counter.last = regrid.pad_record(counter.last, r)
+    sink.regrid(r, dataclasses.replace(new_setup, notes=tuple(setup.notes) + (regrid.describe(r),)), new_filled,
+                regrid.replanned(plan, r, plane), state)
+    return state
+
+
+def _simulate_on(setup, plan, counter, sink: _Sink, observers, progress, state) -> tuple[str, str]:
+    """One stretch of the loop on one grid (a DomainError passes through to be widened)."""
     try:
         last = simulate(setup, (counter, sink) + tuple(observers), progress, resume=state)
+    except DomainError:
+        raise
     except ResolutionError as exc:  # found before anything is written: an input problem, named as such
         given = any(c.key == "grid.elements" and c.given for c in plan.choices)
         key = "grid.elements" if given else "grid"
         advice = ("refine grid.elements or shrink grid.domain" if given else
                   "the automatic grid should resolve it: set grid.domain and grid.elements explicitly")
-        raise CaseError(filled.source, [(key, f"{exc}; {advice}")]) from None
+        raise CaseError(sink.filled.source, [(key, f"{exc}; {advice}")]) from None
     except PhysicalLimit as exc:
         return "stopped", str(exc)
     except SimulationError as exc:

@@ -59,7 +59,7 @@ def check_edges(p: np.ndarray, band: int, grid, cycle: int, y_edges_free: bool) 
         extent = (grid.x[-1] - grid.x[0] + grid.dx) if hit_x else (grid.y[-1] - grid.y[0] + grid.dy)
         raise DomainError(f"the contact reached the {'x' if hit_x else 'y'} edge of the grid at cycle {cycle} "
                           f"(extent {extent:.4g} mm): enlarge grid.domain, or leave grid empty for automatic "
-                          f"sizing", cycle)
+                          f"sizing", cycle, "x" if hit_x else "y")
 
 
 def check_invariant(error: float, invariant: str, n: int) -> None:

@@ -41,6 +41,7 @@ class Results:
     provenance: list = field(default_factory=list)  # (key, value, reason, given, error) of each, as first planned
     inputs: dict = field(default_factory=dict)  # name: (value, units)
     overrides: list = field(default_factory=list)
+    regrids: list = field(default_factory=list)  # the automatic grid's widenings (fretsim.regrid.Regrid), in order
 
     @property
     def status(self) -> str:
@@ -243,10 +244,11 @@ def _read(f, path: str, for_resume: bool) -> Results:
             raise _Damaged(f"/choices: {n} keys but {len(given)} given flags and {len(error)} errors")
         provenance = [(*c, g, e) for c, g, e in zip(choices, given, error)]
     inputs, overrides = _read_inputs(f)
+    regrids = _read_regrids(f, (nx, ny)) if "regrids" in f else []
     return Results(path=path, attrs=attrs, case_yaml=case_yaml, x=x, y=y, history=history, fields=fields,
                    summary=summary, units=units, checkpoint=checkpoint, fretting_loop=loop, choices=choices,
                    provenance=provenance,
-                   inputs=inputs, overrides=overrides)
+                   inputs=inputs, overrides=overrides, regrids=regrids)
 
 
 # what each format added that a file of an older one cannot hold: (test, its description)
@@ -367,6 +369,24 @@ def _read_inputs(f) -> tuple[dict, list]:
         except (ValueError, TypeError):
             raise _Damaged("/inputs: its overrides attribute is not a JSON list") from None
     return inputs, overrides
+
+
+def _read_regrids(f, elements: tuple) -> list:
+    """/regrids as :class:`fretsim.regrid.Regrid` records; the last must end on the file's grid."""
+    from fretsim.regrid import Regrid
+    _group(f, "regrids")
+    cycles = _dataset(f, "regrids/cycle", 1)
+    n = cycles.size
+    cols = {k: _dataset(f, f"regrids/{k}", 1, shape=(n,)) for k in
+            (f"{w}_{q}_{a}" for w in ("old", "new") for q in ("elements", "domain") for a in "xy")}
+    reasons = [text(v) for v in _dataset(f, "regrids/reason", 1, numeric=False, shape=(n,))]
+    out = [Regrid(int(cycles[i]), (int(cols["old_elements_x"][i]), int(cols["old_elements_y"][i])),
+                  (int(cols["new_elements_x"][i]), int(cols["new_elements_y"][i])),
+                  (float(cols["old_domain_x"][i]), float(cols["old_domain_y"][i])),
+                  (float(cols["new_domain_x"][i]), float(cols["new_domain_y"][i])), reasons[i]) for i in range(n)]
+    if out and out[-1].new_elements != elements:
+        raise _Damaged(f"/regrids: the last widening ends on {out[-1].new_elements} elements, the grid has {elements}")
+    return out
 
 
 def _read_checkpoint(f, shape: tuple) -> dict:

@@ -41,7 +41,7 @@ class ResultsWriter:
 
     def __init__(self, path: str | Path, case_yaml: str, case_name: str, grid, notes=(), overwrite: bool = False,
                  previous: Optional["Results"] = None, choices=(), inputs: Optional[dict] = None,
-                 input_sha256: str = ""):
+                 input_sha256: str = "", regrids=()):
         self.path = Path(path)
         self.replace = overwrite or previous is not None
         if self.path.exists() and not self.replace:
@@ -61,6 +61,7 @@ class ResultsWriter:
         else:
             self.rows, self.fields, self.field_cycles = [], {k: [] for k in FIELDS}, []
             self.loops = []  # (applied displacement um, tangential force N) at each snapshot
+        self.regrids = list(regrids)  # the automatic grid's widenings (fretsim.regrid.Regrid)
         self.status, self.message, self.summary = "running", "", {}
         self.state: Optional[dict] = None
         self._flushed = -math.inf
@@ -86,6 +87,15 @@ class ResultsWriter:
         # a flush rebuilds the whole file (tens of ms): never let flushing take more than ~5 % of a long run
         if now - self._flushed > max(FLUSH_SECONDS, FLUSH_COST_FACTOR * self._flush_cost):
             self.flush()
+
+    def regrid(self, r, grid, case_yaml: str, choices, notes) -> None:
+        """The run moved onto a widened grid (:mod:`fretsim.regrid`): the snapshots so far are padded onto it (the
+        new elements were unworn and unloaded), the case and choices are the ones it now runs (a resume plans this
+        grid), and the widening is recorded."""
+        from fretsim.regrid import pad  # (the results package does not depend on the loop's modules otherwise)
+        self.fields = {k: [pad(a, r) for a in v] for k, v in self.fields.items()}
+        self.grid, self.case_yaml, self.choices, self.notes = grid, case_yaml, tuple(choices), tuple(notes)
+        self.regrids.append(r)
 
     def finish(self, status: str, message: str = "", summary: Optional[dict] = None) -> None:
         self.status, self.message = status, message
@@ -191,20 +201,9 @@ class ResultsWriter:
             ds = w.dataset(fl, name, data, units=units, long_name=long_name)
             for axis, scale in enumerate(scales):
                 ds.dims[axis].attach_scale(scale)
-        lp = w.group(f, "fretting_loop")
-        w.attrs(lp, long_name="the fretting loop at each snapshot: the rig's displacement and the tangential "
-                              "force round one cycle (−δ → +δ → −δ); no points for uniform slip")
-        lcyc = w.dataset(lp, "cycle", np.array(self.field_cycles, dtype="i8"), units="cycles",
-                         long_name="cycle number of the snapshot")
-        lcyc.make_scale("cycle")
-        points = max((len(u) for u, _ in self.loops), default=0)
-        for name, k, units, long_name in (("displacement", 0, "um", "the rig's tangential displacement"),
-                                          ("tangential_force", 1, "N", "the tangential force Q (total)")):
-            data = np.full((len(self.loops), points), np.nan)
-            for i, pair in enumerate(self.loops):
-                data[i, :len(pair[k])] = pair[k]
-            ds = w.dataset(lp, name, data, units=units, long_name=long_name)
-            ds.dims[0].attach_scale(lcyc)
+        self._write_loops(w, f)
+        if self.regrids:
+            self._write_regrids(w, f)
         s = w.group(f, "summary")
         for key, value in self.summary.items():
             w.dataset(s, key, value, units=SUMMARY_UNITS.get(key, "1"), long_name=summary_long_name(key))
@@ -222,6 +221,39 @@ class ResultsWriter:
                     c.attrs[key] = value
             c.attrs["sha256"] = checkpoint_digest(self.state)
         w.seal()
+
+    def _write_loops(self, w: "_SealingWriter", f: h5py.File) -> None:
+        lp = w.group(f, "fretting_loop")
+        w.attrs(lp, long_name="the fretting loop at each snapshot: the rig's displacement and the tangential "
+                              "force round one cycle (−δ → +δ → −δ); no points for uniform slip")
+        lcyc = w.dataset(lp, "cycle", np.array(self.field_cycles, dtype="i8"), units="cycles",
+                         long_name="cycle number of the snapshot")
+        lcyc.make_scale("cycle")
+        points = max((len(u) for u, _ in self.loops), default=0)
+        for name, k, units, long_name in (("displacement", 0, "um", "the rig's tangential displacement"),
+                                          ("tangential_force", 1, "N", "the tangential force Q (total)")):
+            data = np.full((len(self.loops), points), np.nan)
+            for i, pair in enumerate(self.loops):
+                data[i, :len(pair[k])] = pair[k]
+            ds = w.dataset(lp, name, data, units=units, long_name=long_name)
+            ds.dims[0].attach_scale(lcyc)
+
+    def _write_regrids(self, w: "_SealingWriter", f: h5py.File) -> None:
+        g = w.group(f, "regrids")
+        w.attrs(g, long_name="each widening of the automatic grid: the earlier snapshots are padded onto the last "
+                             "grid with zeros (the new elements were unworn and unloaded)")
+        rs = self.regrids
+        w.dataset(g, "cycle", np.array([r.cycle for r in rs], dtype="i8"), units="cycles",
+                  long_name="the state the run went back to and continued from on the wider grid")
+        for i, axis in enumerate("xy"):
+            for when in ("old", "new"):
+                w.dataset(g, f"{when}_elements_{axis}", np.array([getattr(r, f"{when}_elements")[i] for r in rs],
+                                                                 dtype="i8"), units="1",
+                          long_name=f"elements along {axis} {'before' if when == 'old' else 'after'}")
+                w.dataset(g, f"{when}_domain_{axis}", np.array([getattr(r, f"{when}_domain")[i] for r in rs],
+                                                               dtype=float), units="mm",
+                          long_name=f"extent along {axis} {'before' if when == 'old' else 'after'}")
+        w.dataset(g, "reason", [r.reason for r in rs], h5py.string_dtype())
 
     def _write_inputs(self, w: "_SealingWriter", f: h5py.File) -> None:
         g = w.group(f, "inputs")

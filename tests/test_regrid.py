@@ -1,0 +1,144 @@
+"""The grid follows the contact (issue 32): an automatic grid the contact outgrows is widened during the run,
+exactly (the same elements, the new ones unworn), recorded, resumable; a grid the case gives is never changed.
+
+The planner's scar estimate is made 30× too small in volume here (a wear coefficient in a sample's high tail
+does this in practice), so that the automatic grid of McColl 185 N 2D is outgrown twice in 18 000 cycles."""
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import fretsim.plan.grid as plan_grid
+from fretsim.api import load_case, resume, run
+from fretsim.results import read_results
+
+CASE = Path(__file__).resolve().parent.parent / "cases" / "mccoll_185N.yaml"
+UNIFORM = ["model.dimension=2d", "grid.error_estimate=none", "model.slip=uniform"]
+COULOMB = ["model.dimension=2d", "grid.error_estimate=none", "loading.friction_coefficient=0.9",
+           "model.slip=coulomb", "model.stroke=mid_stroke"]
+
+
+@pytest.fixture
+def underestimated(monkeypatch):
+    """The automatic grid sized for a thirtieth of the worn volume the run will reach."""
+    real = plan_grid.auto_grid
+
+    def small(*args, **kw):
+        if kw.get("volume") is not None:
+            kw["volume"] = kw["volume"] / 30
+        return real(*args, **kw)
+
+    monkeypatch.setattr(plan_grid, "auto_grid", small)
+    return real
+
+
+def _given(grid) -> list[str]:
+    return [f"grid.domain=[{grid.shape[1] * grid.dx!r} mm]", f"grid.elements=[{grid.shape[1]}]"]
+
+
+def test_an_outgrown_automatic_grid_is_widened_and_the_run_matches_one_on_the_wide_grid_from_the_start(
+        tmp_path, underestimated, monkeypatch):
+    out = run(load_case(CASE, UNIFORM), tmp_path / "r.h5")
+    assert out.status == "complete", out.message
+    r = read_results(tmp_path / "r.h5")
+    assert len(r.regrids) == 2  # 171 → 275 → 441 elements: the planned grid held the first ~1300 cycles
+    assert all(a.new_elements[0] > a.old_elements[0] for a in r.regrids)
+    assert r.regrids[-1].new_elements[0] == r.x.size and r.fields["wear_depth_stationary"].shape[-1] == r.x.size
+    # exact transfer: the element centres of every grid are element centres of the last one
+    first = r.regrids[0]
+    old_x = (np.arange(first.old_elements[0]) - (first.old_elements[0] - 1) / 2) * (r.x[1] - r.x[0])
+    assert np.isin(np.round(old_x / (r.x[1] - r.x[0])), np.round(r.x / (r.x[1] - r.x[0]))).all()
+    # conservation across the regrids: every snapshot's worn volume (padded onto the last grid) is Archard's
+    dx_mm, length = float(r.x[1] - r.x[0]), out.case.geometry.line_length
+    load, stroke = out.case.loading.peak_load, out.case.loading.peak_stroke
+    k_s = out.case.stationary.wear_coefficient
+    for cycle, depth in zip(r.fields["cycle"], r.fields["wear_depth_stationary"]):
+        volume = depth.sum() * 1e-3 * dx_mm * length
+        assert volume == pytest.approx(k_s * load * 4 * stroke * cycle, rel=1e-9, abs=1e-15)
+    assert any("widened along x" in n for n in out.notes)
+    assert "widened along x" in r.attrs["notes"]
+    choices = {c[0]: c for c in r.choices}
+    assert "widened" in choices["grid.elements"][2]
+    # the same run on the final grid given from the start: the regrids change nothing but the cost
+    monkeypatch.setattr(plan_grid, "auto_grid", underestimated)
+    wide = run(load_case(CASE, UNIFORM + _given(out.setup.grid)))
+    for key in ("centre_wear_depth_stationary_um", "scar_width_stationary_mm", "wear_volume_stationary_mm3",
+                "max_pressure_MPa"):
+        assert out.summary[key] == pytest.approx(wide.summary[key], rel=1e-9), key
+
+
+def test_a_users_grid_is_never_widened(underestimated):
+    sets = UNIFORM + ["grid.domain=[0.2683 mm]", "grid.elements=[171]"]  # the planned grid above, given
+    out = run(load_case(CASE, sets))
+    assert out.status == "failed" and "reached the x edge" in out.message
+    assert out.setup.grid.shape[1] == 171
+
+
+def test_a_run_interrupted_after_a_regrid_resumes_bit_for_bit(tmp_path, underestimated):
+    whole = run(load_case(CASE, COULOMB + ["loading.cycles=4000"]), tmp_path / "whole.h5")
+    a = read_results(tmp_path / "whole.h5")
+    assert whole.status == "complete" and len(a.regrids) == 2
+    # a few steps past the first regrid: the resumed run goes on from the first wider grid and widens it again
+    steps = int(np.searchsorted(a.history["cycle"], a.regrids[0].cycle)) + 5
+    assert a.history["cycle"][steps] < a.regrids[1].cycle
+
+    class CtrlC:
+        def __init__(self, n):
+            self.n = n
+
+        def on_step(self, setup, step):
+            self.n -= 1
+            if self.n == 0:
+                raise KeyboardInterrupt
+
+    with pytest.raises(KeyboardInterrupt):
+        run(load_case(CASE, COULOMB + ["loading.cycles=4000"]), tmp_path / "cut.h5", observers=(CtrlC(steps),))
+    cut = read_results(tmp_path / "cut.h5")
+    assert cut.status == "interrupted" and cut.regrids == a.regrids[:1]
+    assert cut.x.size == a.regrids[0].new_elements[0]
+    assert resume(tmp_path / "cut.h5").status == "complete"
+    b = read_results(tmp_path / "cut.h5")
+    assert b.regrids == a.regrids
+    for name in ("cycle", "wear_depth_stationary", "wear_depth_moving", "pressure", "slip_distance_stationary"):
+        np.testing.assert_array_equal(b.fields[name], a.fields[name], err_msg=name)
+    np.testing.assert_array_equal(b.history["cycle"], a.history["cycle"])
+    assert b.summary["centre_wear_depth_stationary_um"] == a.summary["centre_wear_depth_stationary_um"]
+
+
+def test_a_point_contact_widens_along_x_and_along_y_and_matches_the_wide_grid(underestimated, monkeypatch):
+    seat_rail = CASE.parent / "seat_rail.yaml"
+    sets = ["grid.error_estimate=none", "loading.cycles=1000"]
+    out = run(load_case(seat_rail, sets))
+    assert out.status == "complete", out.message
+    widened = " ".join(n for n in out.setup.notes if "widened" in n)
+    assert "widened along x" in widened and "widened along y" in widened
+    g = out.setup.grid
+    monkeypatch.setattr(plan_grid, "auto_grid", underestimated)
+    wide = run(load_case(seat_rail, sets + [f"grid.domain=[{g.shape[1] * g.dx!r} mm, {g.shape[0] * g.dy!r} mm]",
+                                            f"grid.elements=[{g.shape[1]}, {g.shape[0]}]"]))
+    for key in ("max_wear_depth_stationary_um", "scar_width_stationary_mm", "wear_volume_stationary_mm3"):
+        assert out.summary[key] == pytest.approx(wide.summary[key], rel=1e-9), key
+    assert out.summary["archard_volume_error"] < 1e-12
+
+
+def test_a_ctrl_c_while_the_grid_is_widened_leaves_a_file_that_resumes_to_the_same_answer(tmp_path, underestimated,
+                                                                                           monkeypatch):
+    import fretsim.runner as runner
+    whole = run(load_case(CASE, UNIFORM), tmp_path / "whole.h5")
+    real_prepare = runner.prepare
+
+    def interrupted(case, **kw):  # the widening's plan: Ctrl-C arrives while it is made
+        raise KeyboardInterrupt
+
+    monkeypatch.setattr(runner, "prepare", lambda case, **kw: (interrupted if case.domain is not None and
+                                                               case.elements is not None else real_prepare)(case, **kw))
+    with pytest.raises(KeyboardInterrupt):
+        run(load_case(CASE, UNIFORM), tmp_path / "cut.h5")
+    cut = read_results(tmp_path / "cut.h5")
+    assert cut.status == "interrupted" and not cut.regrids  # still the planned grid, its last step's checkpoint
+    monkeypatch.setattr(runner, "prepare", real_prepare)
+    assert resume(tmp_path / "cut.h5").status == "complete"
+    a, b = read_results(tmp_path / "whole.h5"), read_results(tmp_path / "cut.h5")
+    assert b.regrids == a.regrids
+    np.testing.assert_array_equal(b.fields["wear_depth_stationary"], a.fields["wear_depth_stationary"])
+    assert whole.summary["centre_wear_depth_stationary_um"] == b.summary["centre_wear_depth_stationary_um"]
