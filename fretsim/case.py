@@ -258,7 +258,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
                               "companion", choices=GRID_ERRORS)},
     "output": {
         "snapshots": Key("cycle_list", "cycles at which fields are written (+ the last); auto: 0, N/4, N/2, "
-                                       "3N/4, N", None)},
+                                       "3N/4, N; with limits, quarters of the pilot's predicted stop (else the "
+                                       "decades below N) and N", None)},
 }
 SECTIONS = ("name", "geometry", "materials", "loading", "model", "solver", "jumping", "grid", "output", "limits",
             "expected")

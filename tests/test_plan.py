@@ -60,6 +60,20 @@ def test_grid_holds_the_scar_and_the_stroke_at_the_accuracy_rule_and_records_the
     assert [ch.key for ch in plan.choices] == ["grid.domain", "grid.elements", "output.snapshots"]
 
 
+def test_a_limited_runs_automatic_states_are_quarters_of_its_predicted_stop_else_decades_and_always_n():
+    """With wear limits loading.cycles is an upper bound: the states go on the way to the pilot's stop (N kept,
+    should the run get there); to N where the pilot reached no limit; at the decades where nothing predicts it."""
+    limited = _case("loading.cycles=1000000", "output.snapshots=auto", "limits.max_wear_depth_stationary=1 um")
+    to_stop = grid.choose_snapshots(limited, 12_345.4)
+    assert to_stop.value == (0, 3086, 6172, 9258, 1_000_000)
+    assert "S = 12,345 cycles" in to_stop.reason and "pilot" in to_stop.reason
+    assert grid.choose_snapshots(limited, math.inf).value == (0, 250_000, 500_000, 750_000, 1_000_000)
+    unknown = grid.choose_snapshots(limited, None)
+    assert unknown.value == (0, 10, 100, 1000, 10_000, 100_000, 1_000_000) and "decades" in unknown.reason
+    no_limit = _case("loading.cycles=1000", "output.snapshots=auto")
+    assert grid.choose_snapshots(no_limit, 200.0).value == (0, 250, 500, 750, 1000)  # a prediction needs a limit
+
+
 def test_grid_keeps_the_automatic_element_over_a_given_domain_and_refuses_a_domain_shorter_than_the_stroke():
     case = _case("loading.cycles=1000")
     c = inputs.contact(case, Plan())

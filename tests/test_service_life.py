@@ -169,6 +169,21 @@ def test_a_tubes_wall_loss_limit_stops_at_that_fraction_of_its_wall(tmp_path):
     assert out.summary["max_wear_depth_moving_um"] == pytest.approx(0.05 * 1000, rel=2e-3)  # a 1 mm wall
 
 
+def test_a_service_runs_automatic_states_fall_on_the_way_to_its_limit_not_after_it(tmp_path):
+    """The shipped tube in service stops at its wall limit near 10⁹ cycles of a 5·10⁹ upper bound: the automatic
+    states at quarters of the upper bound all lay past the stop, so the history's profiles showed only cycle 0
+    and the stop.  They now fall on the way to the pilot's predicted stop (2 s, without the grid's companions)."""
+    from pathlib import Path
+    tube = Path(__file__).resolve().parent.parent / "cases" / "tube_service_RT.yaml"
+    out = run(load_case(tube, ["grid.error_estimate=none"]), tmp_path / "t.h5")
+    assert out.summary["limit_reached"] == "wall_loss"
+    stop = out.summary["cycles"]
+    recorded = read_results(tmp_path / "t.h5").fields["cycle"]
+    on_the_way = [int(n) for n in recorded if 0 < n < stop]
+    assert len(on_the_way) >= 3, list(recorded)
+    assert recorded[-1] == stop  # the stop itself is recorded; the upper bound, never reached, is not
+
+
 class _StopAt:
     def __init__(self, k):
         self.k, self.n = k, 0

@@ -5,8 +5,8 @@
 can be repeated — or resumed — exactly.  It reads as its stages, in order, each a module of this package:
 
 1. :mod:`.inputs` — plausible input, the elastic model's range, the unworn contact;
-2. :mod:`.model` (its pilot) — the cycles a run with wear limits is sized for;
-3. :mod:`.grid` — the domain, the elements, the recorded states, the memory;
+2. :mod:`.model` (its pilot) — where a run with wear limits is expected to stop, and the cycles it is sized for;
+3. :mod:`.grid` — the domain, the elements, the recorded states (on the way to the expected stop), the memory;
 4. :mod:`.model` — the dimension, the corrections and the gap model (auto's proxies), and their operators;
 5. :mod:`.cycle` — the regime of every block and the fretting-cycle member (a partial-slip contact sends the
    planner back to 3 on a finer grid), then the member built by its family for each block;
@@ -50,7 +50,8 @@ def prepare(case: Case, allow_unstable: bool = False, runs: Optional[SideRuns] =
     plan = Plan()
     case = inputs.tighten_for_pressure(case, plan)
     contact = inputs.contact(case, plan)
-    sized = model.cycles_to_size(case, plan, runs, plan_case, pilot)
+    expected = model.expected_stop(case, runs, plan_case, pilot)
+    sized = model.cycles_to_size(case, plan, expected)
     # auto's proxies compare the models' depths and widths: at a limit the limited one is pinned, so they run
     # without the limits, over the cycles the run will take
     proxy_case = case.with_choices(limits=(), loading=case.loading.with_cycles(sized)) if case.limits else case
@@ -58,7 +59,7 @@ def prepare(case: Case, allow_unstable: bool = False, runs: Optional[SideRuns] =
     while True:  # twice at most: a partial-slip contact is planned again on the grid it needs
         plan = start.copy()
         dimension = plan.add(model.choose_dimension(proxy_case, contact.e_star, runs, plan_case))
-        grids = grid.build(case, plan, contact, dimension, sized, refine)
+        grids = grid.build(case, plan, contact, dimension, sized, refine, expected)
         operators = model.build(case, plan, grids, contact.e_star, proxy_case, runs, plan_case)
         regime = cycle.regime(case, grids.grid, operators.compliance)
         finer = grid.refined(case, regime.slip.value, regime.transition, contact, refine)

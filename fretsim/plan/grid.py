@@ -43,8 +43,10 @@ class Grids:
         return self.grid.plane_strain
 
 
-def build(case: Case, plan: Plan, contact: Contact, dimension: str, sized: int, refine: float) -> Grids:
-    """The run's grid for ``dimension``, sized for the wear of ``sized`` cycles and refined ``refine``-fold."""
+def build(case: Case, plan: Plan, contact: Contact, dimension: str, sized: int, refine: float,
+          expected: Optional[float] = None) -> Grids:
+    """The run's grid for ``dimension``, sized for the wear of ``sized`` cycles and refined ``refine``-fold; a run
+    with wear limits records states on the way to ``expected``, where it is expected to stop (None: unknown)."""
     plane = dimension == "2d"
     g = case.geometry
     if plane and g.axial_profile:
@@ -58,7 +60,7 @@ def build(case: Case, plan: Plan, contact: Contact, dimension: str, sized: int, 
         raise CaseError(case.source, [("grid", "a 3d case needs two entries in grid.domain and grid.elements: "
                                                "[x, y]")])
     nx, ny = elements[0], 1 if plane else elements[1]
-    snapshots = plan.add(choose_snapshots(case))
+    snapshots = plan.add(choose_snapshots(case, expected))
     coarse_shape = _coarse_shape(case, plane, domain)
     _check_memory(case, plane, nx, ny, len(snapshots), coarse_shape, refine)
     grid = Grid.centred(nx, ny, domain[0] / nx, 1.0 if plane else domain[1] / ny, plane_strain=plane)
@@ -114,12 +116,39 @@ def choose_grid(case: Case, plane: bool, sizing: Sizing) -> tuple[Choice, Choice
             Choice("grid.elements", case.elements, "given in the case", True))
 
 
-def choose_snapshots(case: Case) -> Choice:
+def choose_snapshots(case: Case, expected: Optional[float] = None) -> Choice:
+    """The recorded states: the case's, or automatically 0, quarters of the run and its end.
+
+    With wear limits loading.cycles is only an upper bound: the run stops where a limit is reached, often far
+    earlier (the tube in service: near 10⁹ of 5·10⁹ cycles), and quarters of the bound all lay past the stop, so
+    the history's profiles showed cycle 0 and the stop alone.  The quarters are then of ``expected``, the stop a
+    pilot predicts (:func:`fretsim.plan.model.expected_stop`), and N is kept should the run go that far; the
+    predicted stop itself is left out, since the run records the state at its limit whenever it reaches one.
+    Where nothing predicts the stop, the decades 10, 100, … below N: geometric, because the stop may fall
+    anywhere from the first steps to N, and decades put the states a factor ten apart on the way to it wherever it
+    falls, at round cycles, as a log-cycles history reads.  A state past the actual stop is harmless: the run ends
+    at its limit, which is recorded, and never reaches it.
+    """
     if case.snapshots is not None:
         return Choice("output.snapshots", case.snapshots, "given in the case", True)
     n = case.loading.cycles
-    return Choice("output.snapshots", tuple(sorted({0, n // 4, n // 2, 3 * n // 4, n})),
-                  "automatic: 0, N/4, N/2, 3N/4 and N")
+    quarters = "automatic: 0, N/4, N/2, 3N/4 and N"
+    if not case.limits or n <= 0:
+        return Choice("output.snapshots", tuple(sorted({0, n // 4, n // 2, 3 * n // 4, n})), quarters)
+    if expected is None:
+        decades = [10 ** k for k in range(1, len(str(n))) if 10 ** k < n]
+        return Choice("output.snapshots", tuple(sorted({0, *decades, n})),
+                      "automatic, for a run with wear limits and no predicted stop (no pilot run, or it failed): 0, "
+                      "the decades 10, 100, … below N, and N: states on the way to wherever a limit stops the run "
+                      "(the stop itself is recorded)")
+    if expected >= n:
+        return Choice("output.snapshots", tuple(sorted({0, n // 4, n // 2, 3 * n // 4, n})),
+                      quarters + " (a pilot on the paper's grid reached no wear limit before N)")
+    stop = round(expected)
+    return Choice("output.snapshots", tuple(sorted({0, stop // 4, stop // 2, 3 * stop // 4, n})),
+                  f"automatic, for a run with wear limits: 0, S/4, S/2 and 3S/4 on the way to S = {stop:,} cycles, "
+                  f"where a pilot on the paper's grid reached a limit, and N (loading.cycles, the upper bound); the "
+                  f"stop itself is recorded when reached")
 
 
 def _coarse_shape(case: Case, plane: bool, domain: tuple) -> Optional[tuple[int, int]]:

@@ -11,6 +11,7 @@ A run with wear limits is sized for the wear at the limit, which a *pilot* run o
 """
 from __future__ import annotations
 
+import math
 from dataclasses import dataclass
 from typing import Callable, Optional
 
@@ -314,30 +315,37 @@ def _e_star(case: Case) -> float:
 
 # --- a wear limit's pilot ------------------------------------------------------------------------------------
 
-def cycles_to_size(case: Case, plan: Plan, runs: SideRuns, plan_case: PlanCase, pilot: Optional[float]) -> int:
-    """The cycles the grid and auto's proxies take the wear of: loading.cycles, or, with wear limits, PILOT_MARGIN
-    times where a pilot run reached a limit (loading.cycles is then only an upper bound: a scar sized for 10⁹
-    cycles would make the elements far too coarse for the scar at the limit)."""
-    loading = case.loading
-    if not (case.limits and loading.cycles > 0 and (case.elements is None or "auto" in (case.dimension,
-                                                                                        case.corrections))):
-        return loading.cycles
+def expected_stop(case: Case, runs: SideRuns, plan_case: PlanCase, pilot: Optional[float]) -> Optional[float]:
+    """Where a run with wear limits is expected to stop: the cycle where a pilot run reached a limit (inf where it
+    reached none by loading.cycles); None where nothing is known — no limits, a pilot that failed, or none run
+    because nothing is sized from it (the grid given and the model chosen).  ``pilot``: a pilot's result already
+    known (NaN: none is to be run)."""
+    if not (case.limits and case.loading.cycles > 0 and (case.elements is None or "auto" in (case.dimension,
+                                                                                          case.corrections))):
+        return None
     if pilot is None:
         pilot = pilot_cycles(case, runs, plan_case)
-        pilot = float("nan") if pilot is None else pilot
-    if pilot == pilot and PILOT_MARGIN * pilot < loading.cycles:  # reached well before loading.cycles
-        sized = max(1, int(PILOT_MARGIN * pilot))
+    return None if pilot is None or pilot != pilot else pilot
+
+
+def cycles_to_size(case: Case, plan: Plan, expected: Optional[float]) -> int:
+    """The cycles the grid and auto's proxies take the wear of: loading.cycles, or, with wear limits, PILOT_MARGIN
+    times ``expected``, where a pilot run reached a limit (loading.cycles is then only an upper bound: a scar
+    sized for 10⁹ cycles would make the elements far too coarse for the scar at the limit)."""
+    loading = case.loading
+    if expected is not None and PILOT_MARGIN * expected < loading.cycles:  # reached well before loading.cycles
+        sized = max(1, int(PILOT_MARGIN * expected))
         plan.warnings.append(f"wear limits: the grid and auto's proxies take the wear of {sized:,} cycles, "
                              f"{PILOT_MARGIN:g}× where a pilot on the paper's grid reached a limit "
-                             f"({pilot:,.0f}); loading.cycles ({loading.cycles:,}) is the upper bound")
+                             f"({expected:,.0f}); loading.cycles ({loading.cycles:,}) is the upper bound")
         return sized
     return loading.cycles
 
 
 def pilot_cycles(case: Case, runs: SideRuns, plan_case: PlanCase) -> Optional[float]:
     """Where a run with wear limits will stop, roughly: the case on the paper's grid, in 2D where the geometry
-    has it, at a loose stepping tolerance, no companion (None if no limit is reached or the pilot fails).  Its
-    only use is sizing."""
+    has it, at a loose stepping tolerance, no companion (inf if no limit is reached, None if the pilot fails).
+    It sizes the grid and places the automatic recorded states."""
     pilot = case.with_choices(dimension="2d" if case.geometry.has_2d else "3d", corrections="none",
                               grid_rule="paper", grid_error="none", step_tolerance=max(case.step_tolerance, 0.03),
                               pressure_accuracy=None, snapshots=(0,), scheme="bdf2")
@@ -347,7 +355,7 @@ def pilot_cycles(case: Case, runs: SideRuns, plan_case: PlanCase) -> Optional[fl
             setup, _, _ = plan_case(pilot, pilot=float("nan"))
             last = runs.run("wear limits: a pilot run on the paper's grid to find roughly where the limit is "
                             "reached", setup)
-            return float(last.limit[1]) if last.limit else None
+            return float(last.limit[1]) if last.limit else math.inf
         except (SimulationError, CaseError):
             return None
     # auto's proxies prepare variants of the case: one pilot serves them all

@@ -24,7 +24,8 @@ class SideRuns:
     announce: Optional[Callable[[str], None]] = None
     progress: Optional[Callable[[Any], Any]] = None
     proxies: dict = field(default_factory=dict)  # repr(case dict) → the proxy run's summary
-    pilots: dict = field(default_factory=dict)  # repr(case dict) → the cycle a pilot reached a limit at (or None)
+    # repr(case dict) → the cycle a pilot reached a limit at (inf: it reached none; None: it failed)
+    pilots: dict = field(default_factory=dict)
 
     def say(self, what: str) -> None:
         if self.announce is not None:
