@@ -32,6 +32,7 @@ import numpy as np
 
 from fretsim.case import LIMITS_SCHEMA, SCHEMA, Case, CaseError, Key, parse_case
 from fretsim.limits import LIMIT_KEYS
+from fretsim.quantities import shown_unit
 from fretsim.simulate import SimulationError
 from fretsim.units import UnitError, format_quantity, parse_quantity
 from fretsim.sizing import _odd
@@ -272,12 +273,12 @@ def _model(case: Case, measured: Measured) -> np.ndarray:
 
 
 def shown(value: float, key: str, measured: Measured) -> str:
-    """A datum in the unit its column was written in."""
+    """A datum in the unit its column was written in, as the house prints units (a column in um reads µm)."""
     unit = measured.units.get(key)
     kind = "length" if key in PROFILES else LIMITS_SCHEMA[key].kind
     if kind == "fraction" or not unit:
         return f"{value:.5g}"
-    return f"{value / parse_quantity(f'1 {unit}', kind):.5g} {unit}"
+    return f"{value / parse_quantity(f'1 {unit}', kind):.5g} {shown_unit(unit)}"
 
 
 def _residuals(model: np.ndarray, measured: Measured) -> np.ndarray:
@@ -464,8 +465,8 @@ def _check_scale(top: Case, measured: Measured) -> None:
                       f", with the wear coefficients {RANGE:g}× their starting values)")
         problems[key] = (f"column {key} [{measured.units.get(key)}]",
                          f"{shown(v, key, measured)} (row {measured.rows[i]}) is {where}: is the column's unit "
-                         f"right? (" + ("a width in mm written as um is 1000× too narrow)" if small else
-                                        "a value in um written as mm is 1000× too large)"))
+                         f"right? (" + ("a width in mm headed µm reads 1000× too narrow)" if small else
+                                        "a value in µm headed mm reads 1000× too large)"))
     if problems:
         raise CaseError(measured.source, list(problems.values()), "measurements")
 

@@ -26,7 +26,7 @@ import numpy as np  # noqa: E402
 from matplotlib.ticker import FuncFormatter, MaxNLocator  # noqa: E402
 
 from fretsim.measures import centre_line, quantiles, through_origin  # noqa: E402
-from fretsim.quantities import SUMMARY  # noqa: E402
+from fretsim.quantities import SUMMARY, shown_unit  # noqa: E402
 from fretsim.results import Results, ResultsFileError, SweepTable  # noqa: E402
 
 STYLES = ["-", "--", "-.", ":", (0, (5, 1)), (0, (3, 1, 1, 1))]
@@ -125,7 +125,7 @@ def _percent(v: float) -> str:
 
 def _shown(unit: str) -> str:
     """A unit as the files write it (um, mm^3, mm3) as a figure shows it (µm, mm³)."""
-    return unit.replace("um", "µm").replace("mm^3", "mm³").replace("mm3", "mm³")
+    return shown_unit(unit)
 
 
 def _unit(res: Results, key: str) -> str:

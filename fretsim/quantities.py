@@ -125,6 +125,12 @@ SAID = {"max_wear_depth_moving_um": "the moving body's maximum depth",
         "max_pressure_MPa": "the peak pressure"}
 
 
+def shown_unit(unit: str) -> str:
+    """A unit as the files spell it (um, mm^3, mm3 — ASCII, what a case or a CSV header may be written in) as a
+    reader reads it: µm, mm³."""
+    return unit.replace("um", "µm").replace("mm^3", "mm³").replace("mm3", "mm³")
+
+
 def unit_of(summary_key: str) -> str:
     """The unit of a summary figure ("1" for one fretsim does not report)."""
     figure = SUMMARY.get(summary_key)

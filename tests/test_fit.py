@@ -178,7 +178,7 @@ def test_the_fitted_case_keeps_the_set_overrides_and_reruns_to_the_fitted_depth(
     assert fitted.moving.wear_coefficient == K_MOVING
     printed = float(re.search(r"materials.stationary.wear_coefficient = (\S+)", r.output).group(1))
     assert fitted.stationary.wear_coefficient == pytest.approx(printed, rel=1e-3)
-    model = float(re.search(r"18,000  max_wear_depth_stationary: measured \S+ um, model (\S+) um", r.output)
+    model = float(re.search(r"18,000  max_wear_depth_stationary: measured \S+ µm, model (\S+) µm", r.output)
                   .group(1))
     again = run(fitted, tmp_path / "again.h5")
     assert again.summary["max_wear_depth_stationary_um"] == pytest.approx(model, rel=0.01)

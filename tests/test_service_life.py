@@ -1,4 +1,6 @@
 """Load histories and wear limits: blocks of load, stroke and cycles; the cycle at which a limit is reached."""
+import re
+
 import numpy as np
 import pytest
 
@@ -491,13 +493,19 @@ def test_fit_recovers_known_coefficients_from_noisy_data_within_its_own_interval
     assert np.abs(res.residuals).max() < 0.03  # the noise, not a misfit
 
 
-def test_the_fit_command_prints_intervals_and_writes_a_case_that_reruns_the_fit(synthetic, tmp_path):
+def test_the_fit_command_prints_intervals_and_residuals_in_micrometres_and_writes_a_case_that_reruns_the_fit(
+        synthetic, tmp_path):
+    """The measured depths' columns are headed [um], as a CSV may be: the residual lines printed them "0.96556 um";
+    the house prints µm wherever a user reads a unit (figures, tables, this)."""
     out = tmp_path / "fitted.yaml"
     r = CliRunner().invoke(main, ["fit", str(CASES / "mccoll_185N.yaml"), "--measured", str(synthetic), "--set",
                                   "model.dimension=2d", "--fit", "materials.stationary.wear_coefficient", "-o",
                                   str(out)])
     assert r.exit_code == 0, r.output
     assert "materials.stationary.wear_coefficient = " in r.output and "95 % CI" in r.output
+    depths = [line for line in r.output.splitlines() if "max_wear_depth" in line and "measured" in line]
+    assert len(depths) == 6 and all(line.count(" µm") == 2 for line in depths), r.output
+    assert not re.search(r"\bum\b", r.output), r.output
     fitted = load_case(out)
     assert fitted.stationary.wear_coefficient != pytest.approx(3e-8, rel=0.05)  # moved from the case's value
     assert fitted.moving.wear_coefficient == pytest.approx(2e-8)  # not fitted: kept
