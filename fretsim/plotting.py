@@ -62,12 +62,9 @@ def title_block(res: Results) -> str:
     # at a wear limit loading.cycles is only an upper bound: the stop's own line says how long the run was
     length = "" if stop else f"N = {_number(res, 'cycles', '.0f')}{_time_of(res, _float(res, 'cycles'), short=True)}, "
     if res.inputs and nblocks > 1:
-        parts.append(f"load history of {nblocks} blocks: P ≤ {_number(res, 'normal_load', '.4g')} N, δ ≤ "
-                     f"±{_number(res, 'stroke', '.4g')} µm, {length}k_m = "
-                     f"{_number(res, 'moving_wear_coefficient', '.3g')}, k_s = "
-                     f"{_number(res, 'stationary_wear_coefficient', '.3g')} 1/MPa; "
-                     f"{str(_input(res, 'dimension', '')).upper()} {_input(res, 'geometry', '')}, "
-                     f"{_input(res, 'scheme', '')}")
+        parts += textwrap.wrap(f"{_load_history(res, nblocks)}, {length}{_coefficients(res)}; "
+                               f"{str(_input(res, 'dimension', '')).upper()} {_input(res, 'geometry', '')}, "
+                               f"{_input(res, 'scheme', '')}", TITLE_WIDTH, break_long_words=False)
     elif res.inputs:
         parts.append(f"P = {_number(res, 'normal_load', '.4g')} N, δ = ±{_number(res, 'stroke', '.4g')} µm, "
                      f"{length}{_coefficients(res)}; "
@@ -84,6 +81,23 @@ def title_block(res: Results) -> str:
         parts.append("estimated error (stepping + grid + model): "
                      + ", ".join(f"{label} ±{_percent(v)}" for label, v in est))
     return "\n".join(parts)
+
+
+def _load_history(res: Results, applied: int) -> str:
+    """A load history's loads and strokes as ranges over its blocks: "load history of 3 blocks (13 applied): P from
+    5 to 15 N, δ from ±20 to ±80 µm".  A single P (the peak of all blocks, /inputs' normal_load) read as the load
+    the run was under; where the file's case cannot say its blocks, the peaks are said to be bounds."""
+    given = res.load_blocks()
+    if not given:
+        return (f"load history of {applied} blocks: P ≤ {_number(res, 'normal_load', '.4g')} N, "
+                f"δ ≤ ±{_number(res, 'stroke', '.4g')} µm")
+    loads = sorted({p for p, _ in given})
+    strokes = sorted({d * 1e3 for _, d in given})
+    count = f"{len(given)} blocks" + (f" ({applied} applied)" if applied != len(given) else "")
+    load = f"P = {loads[0]:.4g} N" if len(loads) == 1 else f"P from {loads[0]:.4g} to {loads[-1]:.4g} N"
+    stroke = (f"δ = ±{strokes[0]:.4g} µm" if len(strokes) == 1 else
+              f"δ from ±{strokes[0]:.4g} to ±{strokes[-1]:.4g} µm")
+    return f"load history of {count}: {load}, {stroke}"
 
 
 def _stop_line(res: Results) -> str:

@@ -638,6 +638,23 @@ def test_the_title_of_a_run_stopped_at_a_limit_says_where_it_stopped_not_the_upp
     assert f"{n / 5 / 3600 / 8766:.3g} years of continuous fretting at 5 Hz" in title_block(_at_frequency(res, "5 Hz"))
 
 
+def test_a_load_historys_title_gives_its_blocks_ranges_of_load_and_stroke_not_the_peak_as_the_load(service_run):
+    """The tube in service (5, 8 and 15 N at ±20, ±40 and ±80 µm) was titled "P ≤ 15 N, δ ≤ ±80 µm": the peak,
+    which read as the load the tube was under for most of its life."""
+    import dataclasses
+
+    from fretsim.plotting import figures, title_block
+    res = read_results(service_run)
+    fig = figures(res, names=["history"])["history"]
+    title = fig.get_suptitle()
+    applied = int(res.history["block"].max()) + 1  # the blocks the run entered before its stop
+    assert f"load history of 3 blocks ({applied} applied): P from 5 to 15 N, δ from ±20 to ±80 µm, " in title, title
+    assert "P ≤" not in title and "P = " not in title, title
+    _close({"history": fig})
+    # a file whose case cannot say its blocks: the peaks of /inputs, said to be bounds
+    assert "P ≤ 15 N, δ ≤ ±80 µm" in title_block(dataclasses.replace(res, case_yaml=""))
+
+
 def test_the_profiles_show_six_recorded_states_spread_over_the_record_light_to_dark_with_cycle_and_time(
         service_run):
     """Every recorded state was drawn, in the default colour cycle, in a legend over the profiles: 13 states read

@@ -106,6 +106,27 @@ class Results:
             return None
         return hz if math.isfinite(hz) and hz > 0 else None
 
+    def load_blocks(self) -> list:
+        """A load history's blocks as the case gives them, one pass (``loading.blocks`` or ``loading.spectrum``):
+        [(normal load N, stroke mm), ...]; [] for one load, or where the file's case cannot say (what a title
+        quotes beside the peak values of /inputs)."""
+        from fretsim.units import UnitError, parse_quantity
+        loading = self._case_section("loading")
+        given = loading.get("blocks", loading.get("spectrum"))
+        if not isinstance(given, list):
+            return []
+        out = []
+        for block in given:
+            try:
+                load, stroke = (parse_quantity(block[k], kind) for k, kind in (("normal_load", "force"),
+                                                                              ("stroke", "length")))
+            except (TypeError, KeyError, UnitError):
+                return []
+            if not (math.isfinite(load) and math.isfinite(stroke)):
+                return []
+            out.append((load, stroke))
+        return out
+
     def published(self) -> dict:
         """source (experiment, fea, paper) → (the flat's centre-line depth µm, its scar width mm) from the case's
         `expected:` data (None where absent): what figures compare with."""
