@@ -22,6 +22,7 @@ from fretsim.plan.cycle import strip_compliances
 from fretsim.reference import effective_modulus
 from fretsim.results import (OutputBusy, OutputClaim, Results, ResultsIOError, ResultsWriter, check_output_path,
                              read_results)
+from fretsim.results.layout import in_summary_order
 from fretsim.simulate import (DomainError, PhysicalLimit, ResolutionError, SimulationError, Setup, Step, simulate,
                               summarize)
 
@@ -411,7 +412,7 @@ def _summary(setup, counter, t0) -> dict:
     out = summarize(setup, counter.last, counter.solves, _elapsed(counter, t0), counter.errors)
     out.update(counter.extra or {**{k: float("nan") for k in grid_error.KEYS + (grid_error.LIMIT_KEY,)},
                                  "grid_error_wall_time_s": 0.0})
-    return out
+    return in_summary_order(out)
 
 
 def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter", runs: SideRuns) -> dict:

@@ -394,19 +394,24 @@ def run_point_remote(task: tuple) -> dict:
     return row
 
 
-def _state(path: Path, fingerprint: str) -> str:
+def _state(path: Path, fingerprint: str) -> tuple[str, Optional[dict]]:
     """What a point's results file says: missing, complete, resumable, done (failed/stopped), unreadable, or stale
-    (written for other inputs: the base case, the shared `set:` or the file were changed since)."""
+    (written for other inputs: the base case, the shared `set:` or the file were changed since); with, for a file
+    that stands (complete or done), its status, message and summary for the table (read and verified once: a
+    complete sweep's re-run was mostly reading every file twice)."""
     if not path.exists():
-        return "missing"
+        return "missing", None
     from fretsim.results import read_results
     try:
-        res = read_results(path)
+        res = read_results(path, every_seal=False)
     except ValueError:
-        return "unreadable"
+        return "unreadable", None
     if res.attrs.get("input_sha256") != fingerprint:
-        return "stale"
-    return {"complete": "complete", "running": "resumable", "interrupted": "resumable"}.get(res.status, "done")
+        return "stale", None
+    state = {"complete": "complete", "running": "resumable", "interrupted": "resumable"}.get(res.status, "done")
+    stands = state in ("complete", "done") and res.summary
+    return state, ({"status": res.status, "message": res.attrs.get("status_message", ""), "summary": res.summary}
+                   if stands else None)
 
 
 STALE = "ran again: its results file was written for other inputs (the base case, `set:` or the file changed)"
@@ -463,9 +468,9 @@ def _run_claimed(sweep: Sweep, outdir: Path, spec_path: Path, jobs: int, dask: O
     stale = set()
     for p in sweep.points:
         out = outdir / "points" / f"{p.name}.h5"
-        state = "missing" if overwrite else _state(out, p.fingerprint)
+        state, known = ("missing", None) if overwrite else _state(out, p.fingerprint)
         if state == "complete" or state == "done":
-            statuses[p.name] = None  # read from its file for the table
+            statuses[p.name] = known  # None: read from its file for the table
             continue
         if state == "unreadable":
             out.unlink()

@@ -127,6 +127,29 @@ def test_re_running_a_sweep_skips_complete_points(local_sweep):
     assert time.perf_counter() - t < 5
 
 
+def test_a_complete_sweeps_re_run_reads_each_point_once_and_writes_the_same_table_byte_for_byte(tmp_path,
+                                                                                                 monkeypatch):
+    """A re-run used to read every point's file twice (to decide it stands, then for the table) and list the
+    summary's columns in the file's (alphabetical) order rather than the run's: the same sweep gave two tables."""
+    import fretsim.results as results
+    out = tmp_path / "out"
+    run_sweep(load_sweep(sweep_file(tmp_path)), out, jobs=1)
+    first = (out / "table.csv").read_bytes()
+    reads = []
+    real = results.read_results
+    monkeypatch.setattr(results, "read_results", lambda path, *a, **kw: reads.append(path) or real(path, *a, **kw))
+    run_sweep(load_sweep(tmp_path / "s.yaml"), out, jobs=1)
+    assert len(reads) == 4 and len(set(reads)) == 4
+    assert (out / "table.csv").read_bytes() == first
+    # what the re-run trusts is the whole file's checksum: a changed byte still makes the point run again
+    victim = sorted((out / "points").iterdir())[0]
+    data = bytearray(victim.read_bytes())
+    data[-100] ^= 0xFF
+    victim.write_bytes(bytes(data))
+    again = run_sweep(load_sweep(tmp_path / "s.yaml"), out, jobs=1)
+    assert {r["status"] for r in again.rows} == {"complete"} and real(victim).status == "complete"
+
+
 def _small_base(tmp_path, k_moving="2e-8 1/MPa"):
     base = tmp_path / "base.yaml"
     base.write_text((CASES / "mccoll_185N.yaml").read_text().replace("wear_coefficient: 2.0e-8 1/MPa",

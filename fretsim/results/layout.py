@@ -64,6 +64,14 @@ FIELDS = {
 FIELDS_V12 = [k for k in FIELDS if not k.startswith(("slip_distance", "shear"))]
 NAN_FIELDS = {"shear_traction"}  # the uniform model without a friction coefficient does not know it
 SUMMARY_UNITS = {key: figure.unit for key, figure in SUMMARY.items()}
+_SUMMARY_ORDER = {key: i for i, key in enumerate(SUMMARY)}
+
+
+def in_summary_order(summary: dict) -> dict:
+    """A summary in the registry's order (keys it does not know after, by name): a run's and a file's read back
+    list the same keys in the same order, so a sweep's table has the same columns whether its points ran now or
+    were read from their files."""
+    return dict(sorted(summary.items(), key=lambda kv: (_SUMMARY_ORDER.get(kv[0], len(_SUMMARY_ORDER)), kv[0])))
 NAN_SUMMARY = {key for key, figure in SUMMARY.items() if figure.nan}
 
 

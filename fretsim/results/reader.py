@@ -17,7 +17,7 @@ import numpy as np
 from fretsim.errors import ResultsFileError
 from fretsim.results.layout import (FIELDS, FIELDS_V12, FORMAT_VERSION, HISTORY, HISTORY_V11, HISTORY_V12, HISTORY_V13,
                                     HISTORY_V14, MAX_DATASET_BYTES, NAN_FIELDS, NAN_HISTORY, NAN_SUMMARY,
-                                    READABLE_FORMATS, STATUSES)
+                                    READABLE_FORMATS, STATUSES, in_summary_order)
 from fretsim.results.seal import (SEALED_FROM, _SCALE_ATTRS, _Damaged, _verify_seal, checkpoint_digest, plain, text,
                                   verify_image)
 
@@ -215,16 +215,19 @@ def _group(f, path: str):
     return obj
 
 
-def read_results(path: str | Path, for_resume: bool = False) -> Results:
+def read_results(path: str | Path, for_resume: bool = False, every_seal: bool = True) -> Results:
     """Read a results file, verifying it; raises ``ValueError`` naming the file and what is wrong.
 
-    ``for_resume`` also requires a complete, intact checkpoint that fits the grid.
+    ``for_resume`` also requires a complete, intact checkpoint that fits the grid.  ``every_seal`` False trusts the
+    whole-file checksum where the file has one (every byte as written) and skips the per-object seals, which add
+    only the name of what a tool that edits knowingly changed: a sweep deciding which of its points stand reads
+    every file, and the seals were most of that.
     """
     _regular_file(path)
     try:
-        verify_image(path)  # before HDF5 reads a byte: it can loop for ever on some damaged files
+        whole = verify_image(path)  # before HDF5 reads a byte: it can loop for ever on some damaged files
         with h5py.File(path, "r") as f:
-            return _read(f, str(path), for_resume)
+            return _read(f, str(path), for_resume, seals=every_seal or not whole)
     except _Damaged as exc:
         raise ResultsFileError(f"{path}: damaged or not a fretsim results file: {exc}") from None
     except (OSError, RuntimeError, KeyError, TypeError, IndexError, AttributeError, UnicodeDecodeError) as exc:
@@ -232,8 +235,8 @@ def read_results(path: str | Path, for_resume: bool = False) -> Results:
                          f"{str(exc)[:200]})") from None
 
 
-def _read(f, path: str, for_resume: bool) -> Results:
-    version, attrs, case_yaml = _read_head(f, path)
+def _read(f, path: str, for_resume: bool, seals: bool = True) -> Results:
+    version, attrs, case_yaml = _read_head(f, path, seals)
     x = _dataset(f, "grid/x", 1)
     y = _dataset(f, "grid/y", 1)
     if not (x.size and y.size) or (x.size > 1 and not (np.diff(x) > 0).all()) or (y.size > 1 and not (np.diff(y) > 0).all()):
@@ -298,7 +301,7 @@ def _format_held(f) -> str:
     return next((v for v, (holds, _) in _FORMAT_MARKS.items() if holds(f)), "1.1")
 
 
-def _read_head(f, path: str) -> tuple[str, dict, str]:
+def _read_head(f, path: str, seals: bool = True) -> tuple[str, dict, str]:
     """The format version (its checksums verified), the root's attributes and the case's text."""
     if "format_version" not in f.attrs:
         raise ResultsFileError(f"{path} is an HDF5 file but not a fretsim results file (no format_version)")
@@ -309,7 +312,7 @@ def _read_head(f, path: str) -> tuple[str, dict, str]:
     if held > version:
         raise _Damaged(f"format_version {version!r} is older than what the file holds (format {held}: "
                        f"{_FORMAT_MARKS[held][1]}): its version was changed since it was written")
-    if version >= SEALED_FROM or held >= SEALED_FROM:  # never a version that lets the checksums go unread
+    if seals and (version >= SEALED_FROM or held >= SEALED_FROM):  # never a version that lets them go unread
         _verify_seal(f)
     attrs = {k: plain(v) for k, v in f.attrs.items() if k not in _SCALE_ATTRS}
     if attrs.get("status") not in STATUSES:
@@ -373,7 +376,7 @@ def _read_summary(f) -> dict:
         if isinstance(v, float) and not math.isfinite(v) and k not in NAN_SUMMARY:
             raise _Damaged(f"/summary: {k} is not finite")
         summary[k] = v
-    return summary
+    return in_summary_order(summary)  # (HDF5 gives the attributes sorted by name)
 
 
 def _read_inputs(f) -> tuple[dict, list]:

@@ -34,16 +34,17 @@ def seal_image(data: bytes) -> bytes:
     return b"".join((head, memoryview(data)[USERBLOCK:]))  # one copy of the image, not two
 
 
-def verify_image(path) -> None:
+def verify_image(path) -> bool:
     """Refuse (``_Damaged``) a file whose bytes differ from the digest in its user block; a file without a user
-    block (written before it was added) is left to the per-object seals."""
+    block (written before it was added) is left to the per-object seals.  True where the digest was there and
+    matched: every byte is as written."""
     with open(path, "rb") as fh:
         head = fh.read(USERBLOCK)
         if head[:8] == HDF5_SIGNATURE:
-            return
+            return False
         first = fh.read(8)
         if first != HDF5_SIGNATURE:
-            return  # not HDF5 where fretsim puts it: HDF5's own reading says what it is
+            return False  # not HDF5 where fretsim puts it: HDF5's own reading says what it is
         if not head.startswith(IMAGE_MAGIC) or head[len(IMAGE_MAGIC) + 64:len(IMAGE_MAGIC) + 65] != b"\n":
             raise _Damaged("its header block (the first 512 bytes, which hold the file's checksum) is damaged")
         expected = head[len(IMAGE_MAGIC):len(IMAGE_MAGIC) + 64].decode("ascii", "replace")
@@ -53,6 +54,7 @@ def verify_image(path) -> None:
     if h.hexdigest() != expected:
         raise _Damaged("its bytes do not match the checksum written with them (changed since it was written: an "
                        "edit, a flipped bit, a truncated copy)")
+    return True
 
 
 def reseal_file(path) -> None:
