@@ -1,0 +1,9 @@
+"""Fretting fatigue beside wear (issue 34): the stresses under the contact and the crack-initiation life they give.
+
+* :mod:`.stresses` — the plane-strain half-space's stresses under piecewise-constant normal and shear tractions
+  (closed forms of the strips' line-load integrals);
+* :mod:`.swt` — the Smith–Watson–Topper parameter on the critical plane, its life from the Basquin–Coffin–Manson
+  curve, and Ruiz's fretting damage parameter.
+
+Pure functions over arrays; nothing here is wired into the loop yet.
+"""
