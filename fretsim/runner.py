@@ -211,14 +211,16 @@ class _Sink:
         self.writer: Optional[ResultsWriter] = None
         self.regrids: list = list(previous.regrids) if previous is not None else []  # the grid's widenings so far
 
-    def regrid(self, r, setup, filled, plan, state: dict) -> None:
+    def regrid(self, r, setup, filled, plan, state: dict, note: str) -> None:
         """The run moves onto a widened grid, from ``state`` (the last step's, widened): so does what the results
-        file holds of it, its checkpoint included (a Ctrl-C before the next step resumes on the wider grid)."""
+        file holds of it, its checkpoint included (a Ctrl-C before the next step resumes on the wider grid), and
+        its notes gain ``note`` at once (a killed run's last flush says so too)."""
         self.open(self.overwrite)  # a resumed run may widen before its first step: the file's snapshots go too
         self.regrids.append(r)
         self.setup, self.filled, self.plan = setup, filled, plan
         if self.writer is not None:
-            self.writer.regrid(r, setup.grid, filled.to_yaml(), plan.choices, setup.notes)
+            self.writer.regrid(r, setup.grid, filled.to_yaml(), plan.choices,
+                               tuple(dict.fromkeys(self.writer.notes + (note,))))
             self.writer.state = state
 
     def open(self, overwrite: bool) -> None:
@@ -307,24 +309,39 @@ def _simulate(counter, sink: _Sink, observers, progress, state, runs: SideRuns) 
         try:
             return _simulate_on(sink.setup, sink.plan, counter, sink, observers, progress, state)
         except DomainError as exc:
-            state = _widen(exc, counter, sink, runs, state)
+            state, why = _widen(exc, counter, sink, runs, state)
             if state is None:
-                return "failed", str(exc)
+                return "failed", _unwidened(exc, sink.setup.grid, why)
 
 
-def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns, resumed: Optional[dict]) -> Optional[dict]:
+def _unwidened(exc: DomainError, grid, why: str) -> str:
+    """A run stopped at the edge of its grid: the loop's words for the user's grid (enlarge it), why an automatic
+    grid was not widened for an automatic one (its advice, to leave the grid empty, was what the case had done)."""
+    if not why:
+        return str(exc)
+    ny, nx = grid.shape
+    extent = nx * grid.dx if exc.axis == "x" else ny * grid.dy
+    return (f"the contact reached the {exc.axis} edge of the automatic grid at cycle {exc.cycle} (extent "
+            f"{extent:.4g} mm) and {why}; give grid.domain and grid.elements for a domain that holds the scar")
+
+
+def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns,
+           resumed: Optional[dict]) -> tuple[Optional[dict], str]:
     """The last step's state (or the one the run was ``resumed`` from, before its first step) on a grid widened
     where the contact reached its edge, the run's setup and its results file moved onto it; None where the grid
     may not or cannot grow (the user's grid, too many widenings, nothing to go back to, a grid the planner
-    refuses), with the reason noted."""
+    refuses), with why an automatic grid was not widened ("" for the user's grid, or nothing to go back to).
+    The widening is one of the run's notes (as the refusals are), so `fretsim run` prints it after the plan's."""
     setup, filled, plan = sink.setup, sink.filled, sink.plan
     base = counter.last.state if counter.last is not None else resumed
     if not regrid.grid_is_automatic(plan) or not base:
-        return None
+        return None, ""
     if len(sink.regrids) >= regrid.MAX_REGRIDS:
-        counter.notes.append(f"the automatic grid was widened {regrid.MAX_REGRIDS} times, the most allowed: the "
-                             f"scar outgrew the planned one far beyond its estimate")
-        return None
+        times = f"{regrid.MAX_REGRIDS} time{'s' if regrid.MAX_REGRIDS != 1 else ''}"
+        why = (f"the automatic grid was widened {times}, the most allowed: the scar outgrew the planned one far "
+               f"beyond its estimate")
+        counter.notes.append(why)
+        return None, why
     r = regrid.widened(setup.grid, exc.axis, setup.band, int(base["n"]),
                        f"the contact reached the {exc.axis} edge at cycle {exc.cycle}")
     plane = setup.grid.plane_strain
@@ -333,14 +350,17 @@ def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns, resumed: Opti
     try:
         new_setup, new_filled, _ = prepare(wider, runs=runs)
     except CaseError as err:  # e.g. more memory than the machine has
-        counter.notes.append(f"the automatic grid could not be widened: {str(err).splitlines()[-1][:200]}")
-        return None
+        why = f"the automatic grid could not be widened: {str(err).splitlines()[-1][:200]}"
+        counter.notes.append(why)
+        return None, why
     state = regrid.pad_state(base, r)
     if counter.last is not None:
         counter.last = regrid.pad_record(counter.last, r)
-    sink.regrid(r, dataclasses.replace(new_setup, notes=tuple(setup.notes) + (regrid.describe(r),)), new_filled,
-                regrid.replanned(plan, r, plane), state)
-    return state
+    note = regrid.describe(r)
+    counter.notes.append(note)
+    sink.regrid(r, dataclasses.replace(new_setup, notes=tuple(setup.notes)), new_filled,
+                regrid.replanned(plan, r, plane), state, note)
+    return state, ""
 
 
 def _simulate_on(setup, plan, counter, sink: _Sink, observers, progress, state) -> tuple[str, str]:

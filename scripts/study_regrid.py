@@ -60,12 +60,12 @@ def main() -> None:
         t = time.perf_counter()
         wide = run(load_case(case, base + given))
         wide_s = time.perf_counter() - t
-        count = sum("widened" in n for n in out.setup.notes)
+        count = sum("widened" in n for n in out.notes)
         rel = [abs(out.summary[k] / wide.summary[k] - 1) for _, k in KEYS]
         say(f"{label:<24}{count:>10}{f'{nx}×{ny}':>12}{rel[0]:>11.1e}{rel[1]:>11.1e}{rel[2]:>11.1e}"
             f"{out.summary['archard_volume_error']:>9.0e}{out.summary['wall_time_s']:>8.2f}"
             f"{wide.summary['wall_time_s']:>8.2f}")
-        for n in out.setup.notes:
+        for n in out.notes:
             if "widened" in n:
                 say(f"    {n}")
         say(f"    whole calls (planning included): {widened_s:.2f} s widened, {wide_s:.2f} s on the last grid")

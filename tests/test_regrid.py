@@ -110,7 +110,7 @@ def test_a_point_contact_widens_along_x_and_along_y_and_matches_the_wide_grid(un
     sets = ["grid.error_estimate=none", "loading.cycles=1000"]
     out = run(load_case(seat_rail, sets))
     assert out.status == "complete", out.message
-    widened = " ".join(n for n in out.setup.notes if "widened" in n)
+    widened = " ".join(n for n in out.notes if "widened" in n)
     assert "widened along x" in widened and "widened along y" in widened
     g = out.setup.grid
     monkeypatch.setattr(plan_grid, "auto_grid", underestimated)
@@ -142,3 +142,30 @@ def test_a_ctrl_c_while_the_grid_is_widened_leaves_a_file_that_resumes_to_the_sa
     assert b.regrids == a.regrids
     np.testing.assert_array_equal(b.fields["wear_depth_stationary"], a.fields["wear_depth_stationary"])
     assert whole.summary["centre_wear_depth_stationary_um"] == b.summary["centre_wear_depth_stationary_um"]
+
+
+def test_the_cli_says_that_the_grid_was_widened(tmp_path, underestimated, monkeypatch):
+    """`fretsim run` printed the plan's notes (171 elements) and a paragraph on 441 elements, and never the
+    widenings between them: they were kept among the plan's notes, which the CLI does not repeat after a run."""
+    from click.testing import CliRunner
+    from fretsim.cli import main
+    monkeypatch.chdir(tmp_path)
+    r = CliRunner().invoke(main, ["run", str(CASE), "-o", "r.h5", *(a for s in UNIFORM for a in ("--set", s))])
+    assert r.exit_code == 0, r.output
+    assert r.output.count("note: the automatic grid was widened along x") == 2
+    assert read_results(tmp_path / "r.h5").attrs["notes"].count("the automatic grid was widened") == 2
+
+
+def test_an_automatic_grid_that_may_not_grow_again_says_so_in_the_failure(tmp_path, underestimated, monkeypatch):
+    """At the most widenings allowed the run stopped with the user's-grid advice ("enlarge grid.domain, or leave
+    grid empty for automatic sizing": it was empty), the reason only in the file's notes, which a failed
+    `fretsim run` does not print."""
+    import fretsim.regrid as regrid
+    monkeypatch.setattr(regrid, "MAX_REGRIDS", 1)
+    out = run(load_case(CASE, UNIFORM), tmp_path / "r.h5")
+    assert out.status == "failed" and len(read_results(tmp_path / "r.h5").regrids) == 1
+    assert "leave grid empty" not in out.message
+    assert "widened 1 time, the most allowed" in out.message and "grid.domain" in out.message
+    # the user's grid keeps its advice
+    given = run(load_case(CASE, UNIFORM + ["grid.domain=[0.2683 mm]", "grid.elements=[171]"]))
+    assert "enlarge grid.domain" in given.message
