@@ -150,6 +150,26 @@ def test_a_complete_sweeps_re_run_reads_each_point_once_and_writes_the_same_tabl
     assert {r["status"] for r in again.rows} == {"complete"} and real(victim).status == "complete"
 
 
+def test_a_re_run_does_not_take_a_point_whose_summary_was_edited_into_its_table(tmp_path):
+    """A re-run trusts the whole-file checksum, not every object's: a point file edited and its whole-file
+    checksum written again (conftest.edited, as a tool that edits knowingly would) put the edited number into
+    the table, where `fretsim summary` of the same file refuses it; the table's own inputs (the root's and
+    /summary's attributes) are still checked against their seals, and such a point runs again as it used to."""
+    from conftest import edited
+    out = tmp_path / "out"
+    first = run_sweep(load_sweep(sweep_file(tmp_path)), out, jobs=1)
+    victim = sorted((out / "points").iterdir())[0]
+    truth = next(r for r in first.rows if r["point"] == victim.stem)["max_wear_depth_stationary_um"]
+    with edited(victim) as f:
+        f["summary"].attrs["max_wear_depth_stationary_um"] = 1e-3
+    with pytest.raises(ValueError, match="/summary"):
+        read_results(victim)
+    again = run_sweep(load_sweep(tmp_path / "s.yaml"), out, jobs=1)
+    row = next(r for r in again.rows if r["point"] == victim.stem)
+    assert row["status"] == "complete" and row["max_wear_depth_stationary_um"] == pytest.approx(truth, rel=1e-12)
+    assert read_results(victim).summary["max_wear_depth_stationary_um"] == pytest.approx(truth, rel=1e-12)
+
+
 def _small_base(tmp_path, k_moving="2e-8 1/MPa"):
     base = tmp_path / "base.yaml"
     base.write_text((CASES / "mccoll_185N.yaml").read_text().replace("wear_coefficient: 2.0e-8 1/MPa",

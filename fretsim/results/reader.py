@@ -18,8 +18,8 @@ from fretsim.errors import ResultsFileError
 from fretsim.results.layout import (FIELDS, FIELDS_V12, FORMAT_VERSION, HISTORY, HISTORY_V11, HISTORY_V12, HISTORY_V13,
                                     HISTORY_V14, MAX_DATASET_BYTES, NAN_FIELDS, NAN_HISTORY, NAN_SUMMARY,
                                     READABLE_FORMATS, STATUSES, in_summary_order)
-from fretsim.results.seal import (SEALED_FROM, _SCALE_ATTRS, _Damaged, _verify_seal, checkpoint_digest, plain, text,
-                                  verify_image)
+from fretsim.results.seal import (SEALED_FROM, _SCALE_ATTRS, _Damaged, _verify_attrs_seal, _verify_seal,
+                                  checkpoint_digest, plain, text, verify_image)
 
 
 @dataclass
@@ -219,9 +219,11 @@ def read_results(path: str | Path, for_resume: bool = False, every_seal: bool = 
     """Read a results file, verifying it; raises ``ValueError`` naming the file and what is wrong.
 
     ``for_resume`` also requires a complete, intact checkpoint that fits the grid.  ``every_seal`` False trusts the
-    whole-file checksum where the file has one (every byte as written) and skips the per-object seals, which add
-    only the name of what a tool that edits knowingly changed: a sweep deciding which of its points stand reads
-    every file, and the seals were most of that.
+    whole-file checksum where the file has one (every byte as written) and skips the per-object seals of the
+    datasets: a sweep deciding which of its points stand reads every file, and the seals were most of that.  The
+    attributes of the root and of /summary (the status and the figures a sweep's table takes) are still checked
+    against theirs (a few ms): a file edited and its whole-file checksum written again, which every other reader
+    refuses, must not give the table its numbers.
     """
     _regular_file(path)
     try:
@@ -312,8 +314,12 @@ def _read_head(f, path: str, seals: bool = True) -> tuple[str, dict, str]:
     if held > version:
         raise _Damaged(f"format_version {version!r} is older than what the file holds (format {held}: "
                        f"{_FORMAT_MARKS[held][1]}): its version was changed since it was written")
-    if seals and (version >= SEALED_FROM or held >= SEALED_FROM):  # never a version that lets them go unread
-        _verify_seal(f)
+    if version >= SEALED_FROM or held >= SEALED_FROM:  # never a version that lets them go unread
+        if seals:
+            _verify_seal(f)
+        else:  # the whole file's bytes are as written: what the caller reports (status, summary) as sealed too,
+            #    so that a file edited and its whole-file checksum written again is refused as every reader does
+            _verify_attrs_seal(f, ("", "summary") if "summary" in f else ("",))
     attrs = {k: plain(v) for k, v in f.attrs.items() if k not in _SCALE_ATTRS}
     if attrs.get("status") not in STATUSES:
         raise _Damaged(f"the status {str(attrs.get('status'))[:40]!r} is not one of {', '.join(STATUSES)}")

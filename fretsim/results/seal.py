@@ -146,6 +146,20 @@ def _verify_seal(f) -> None:
                            f" do not match their checksum (changed since it was written)")
 
 
+def _verify_attrs_seal(f, names: tuple) -> None:
+    """Refuse a file where the attributes (and member names) of the groups ``names`` ("" the root) differ from
+    their checksums: cheap, no dataset is read (what a reader that trusts the whole-file checksum for the rest
+    still checks of what it reports)."""
+    for name in names:
+        obj = f[name] if name else f
+        where = f"/{name}"
+        if "attrs_sha256" not in obj.attrs:
+            raise _Damaged(f"{where}: the checksum of its attributes is missing")
+        if _attrs_digest(obj) != text(obj.attrs["attrs_sha256"]):
+            raise _Damaged(f"{where}: its attributes or the names it holds do not match their checksum (changed "
+                           f"since it was written)")
+
+
 class _SealingWriter:
     """Creates the sealed groups and datasets of a file and seals them from the values it was given, without
     reading the file back (which cost most of a flush).  Each value is taken in the form HDF5 gives it back (a
