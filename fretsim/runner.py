@@ -357,6 +357,10 @@ def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns,
     if counter.last is not None:
         counter.last = regrid.pad_record(counter.last, r)
     note = regrid.describe(r)
+    if setup.coarse is not None and new_setup.coarse is not None:  # refinement: not nested, so not exact
+        note += (f"; the coarse grid of refinement is re-derived on the wider domain, its element "
+                 f"{setup.coarse.dx * 1e3:.4g} → {new_setup.coarse.dx * 1e3:.4g} µm, so from here the pressure is "
+                 f"solved on slightly different coarse elements")
     counter.notes.append(note)
     sink.regrid(r, dataclasses.replace(new_setup, notes=tuple(setup.notes)), new_filled,
                 regrid.replanned(plan, r, plane), state, note)

@@ -252,7 +252,8 @@ class ResultsWriter:
                           long_name=f"elements along {axis} {'before' if when == 'old' else 'after'}")
                 w.dataset(g, f"{when}_domain_{axis}", np.array([getattr(r, f"{when}_domain")[i] for r in rs],
                                                                dtype=float), units="mm",
-                          long_name=f"extent along {axis} {'before' if when == 'old' else 'after'}")
+                          long_name=f"extent along {axis} {'before' if when == 'old' else 'after'}"
+                                    f"{' (1 in 2D: the plane-strain row)' if axis == 'y' else ''}")
         w.dataset(g, "reason", [r.reason for r in rs], h5py.string_dtype())
 
     def _write_inputs(self, w: "_SealingWriter", f: h5py.File) -> None:
