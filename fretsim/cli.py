@@ -431,11 +431,12 @@ def _limits(s: dict, c) -> str:
     near each came."""
     import math
     from fretsim.limits import LIMIT_KEYS
+    from fretsim.quantities import shown_unit
     if not c.limits:
         return ""
     def shown(key, v):
         kind, unit, f = LIMIT_KEYS[key]
-        return f"{v:.1%}" if kind == "fraction" else f"{v * f:.4g} {unit.replace('um', 'µm').replace('mm3', 'mm³')}"
+        return f"{v:.1%}" if kind == "fraction" else f"{v * f:.4g} {shown_unit(unit)}"
     limits = dict(c.limits)
     if s.get("limit_reached"):
         key, n = s["limit_reached"], s["cycles_to_limit"]

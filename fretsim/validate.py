@@ -29,13 +29,13 @@ from typing import Optional
 import numpy as np
 
 from fretsim.case import CaseError, load_case
-from fretsim.quantities import WEAR
+from fretsim.quantities import WEAR, shown_unit
 from fretsim.units import UnitError, parse_quantity
 
 CASES = Path(__file__).resolve().parent / "cases"
 # expected key: (summary key or None, unit in the report, scale from mm): the wear quantities published values are
 # given for (fretsim.quantities), the unworn contact's half-width and the element
-QUANTITIES = {**{key: (WEAR[key].summary_key, WEAR[key].unit.replace("um", "µm"), WEAR[key].factor)
+QUANTITIES = {**{key: (WEAR[key].summary_key, shown_unit(WEAR[key].unit), WEAR[key].factor)
                  for key in ("centre_wear_depth_stationary", "max_wear_depth_stationary", "max_wear_depth_moving",
                              "scar_width_stationary", "scar_width_moving")},
               "contact_half_width": (None, "mm", 1.0),
