@@ -3,7 +3,7 @@
 The planner sizes the automatic grid for the scar it predicts; a run whose contact outgrows that prediction (a
 wear coefficient in a sample's high tail, a fit's trial far from its start, a load history's heavy block) used to
 stop with "the contact reached the x edge".  Now the run goes back to its last accepted step, the grid gains
-elements of the same size on both sides (a third of its extent or more on each), and the loop continues from that
+elements of the same size on both sides (30 % of its extent or more on each), and the loop continues from that
 state on the wider grid.  Nothing is interpolated: every element of the old grid is an element of the new one, and
 the new elements start unworn and unloaded, which they were (the contact had not reached them), so the worn
 volumes, the pressures and the stepping's memory carry over exactly.  The results file keeps one grid, the
