@@ -139,6 +139,25 @@ GEOMETRY_KEYS: dict[str, dict[str, Key]] = {
                                       "carries it, so a results file reruns without the CSV)", None)},
 }
 
+FATIGUE_SCHEMA: dict[str, Key] = {  # materials.<body>.fatigue: the Basquin–Coffin–Manson curve and its options
+    "strength_coefficient": Key("pressure", "fatigue strength coefficient σ'_f", REQUIRED,
+                                plausible=(10.0, 1e5, "10 MPa to 100 GPa"), example="2030 MPa"),
+    "strength_exponent": Key("number", "fatigue strength exponent b (negative)", REQUIRED, lo=-1.0, hi=-1e-6,
+                             example="-0.104"),
+    "ductility_coefficient": Key("number", "fatigue ductility coefficient ε'_f", REQUIRED, lo=1e-6, hi=10.0,
+                                 example="0.841"),
+    "ductility_exponent": Key("number", "fatigue ductility exponent c (negative)", REQUIRED, lo=-3.0, hi=-1e-6,
+                              example="-0.688"),
+    "critical_distance": Key("length", "the SWT parameter averaged over this depth below each surface point "
+                                       "(the line method: the stress gradient's size effect); omitted: the value "
+                                       "at each point", None, plausible=(1e-6, 10.0, "1 nm to 10 mm"),
+                             example="50 um"),
+    "endurance_limit": Key("pressure", "the fully reversed stress amplitude below which no crack starts: SWT "
+                                       "values below σ_e²/E count no damage; omitted: the curve alone", None,
+                           plausible=(1.0, 1e5, "1 MPa to 100 GPa"), example="300 MPa"),
+}
+FATIGUE_KEYS_TEXT = tuple(FATIGUE_SCHEMA)
+
 SCHEMA: dict[str, dict[str, Key]] = {
     "geometry": {"type": Key("choice", "the contact geometry", REQUIRED, choices=tuple(GEOMETRY_KEYS))},
     "material": {  # each of materials.moving and materials.stationary
@@ -160,7 +179,11 @@ SCHEMA: dict[str, dict[str, Key]] = {
                                           "unworn Hertz peak pressure passes the onset of yield below the surface "
                                           "(p0 = 1.60 σ_y for a point contact, 1.79 σ_y for a line contact; von "
                                           "Mises, ν = 0.3, Johnson §6.2)", None,
-                              plausible=(1.0, 1e5, "1 MPa to 100 GPa"), example="250 MPa")},
+                              plausible=(1.0, 1e5, "1 MPa to 100 GPa"), example="250 MPa"),
+        "fatigue": Key("fatigue", "opt-in fretting fatigue of this body (the stationary flat): the strain-life "
+                                  "curve's constants, a mapping of " + ", ".join(FATIGUE_KEYS_TEXT) + "; with it "
+                                  "the run reports the SWT parameter under the contact, the crack-initiation life "
+                                  "over the wear history and the damage mode (2D; README); omitted: none", None)},
     "loading": {
         "normal_load": Key("force", "normal load P (total, both in 2D and 3D)", REQUIRED,
                            plausible=(1e-6, 1e7, "1 µN to 10 MN"), example="185 N"),
@@ -259,13 +282,17 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "output": {
         "snapshots": Key("cycle_list", "cycles at which fields are written (+ the last); auto: 0, N/4, N/2, "
                                        "3N/4, N; with limits, quarters of the pilot's predicted stop (else the "
-                                       "decades below N) and N", None)},
+                                       "decades below N) and N", None),
+        "stresses": Key("flag", "with fatigue: also write the stationary body's stress components under the "
+                                "contact at the recorded states (/fields/stress_*); omitted: the SWT field only",
+                        False)},
 }
 SECTIONS = ("name", "geometry", "materials", "loading", "model", "solver", "jumping", "grid", "output", "limits",
             "expected")
 # a wear limit per summary quantity (fretsim.limits): the run stops where the first is reached
 LIMITS_SCHEMA = {key: Key(q.kind, q.long_name, None, **({"lo": 1e-6, "hi": 1.0} if q.kind == "fraction" else {}))
                  for key, q in WEAR.items()}
+CRACK_LIMIT = "crack_initiation"  # limits.crack_initiation: true — the fatigue damage's limit, not a wear quantity
 BLOCK_KEYS = ("normal_load", "stroke", "cycles", "friction_coefficient")
 MAX_BLOCKS = 10_000  # blocks after repeats: each restarts the stepping (a few solves)
 
@@ -325,6 +352,19 @@ class Material:
     wear_coefficient: Optional[float]  # 1/MPa (Archard's k)
     energy_wear_coefficient: Optional[float] = None  # mm³/(N·mm) = 1/MPa (α)
     yield_strength: Optional[float] = None  # MPa (σ_y, for the elastic model's range only)
+    fatigue: Optional["Fatigue"] = None  # the strain-life curve (fretting fatigue, opt-in)
+
+
+@dataclass(frozen=True)
+class Fatigue:
+    """``materials.<body>.fatigue``: the Basquin–Coffin–Manson constants and the options of the SWT life."""
+
+    strength_coefficient: float  # σ'_f, MPa
+    strength_exponent: float  # b
+    ductility_coefficient: float  # ε'_f
+    ductility_exponent: float  # c
+    critical_distance: Optional[float] = None  # mm: the line method's averaging depth
+    endurance_limit: Optional[float] = None  # MPa, a stress amplitude
 
 
 @dataclass(frozen=True)
@@ -358,6 +398,8 @@ class Case:
     domain: Optional[tuple[float, ...]] = None  # mm
     elements: Optional[tuple[int, ...]] = None
     snapshots: Optional[tuple[int, ...]] = None
+    crack_limit: bool = False  # limits.crack_initiation: stop where the fatigue damage reaches 1
+    output_stresses: bool = False  # output.stresses
     expected: dict = field(default_factory=dict, compare=False, hash=False)
     overrides: tuple[str, ...] = field(default=(), compare=False)  # --set items as given
     source: str = field(default="<case>", compare=False)
@@ -411,6 +453,10 @@ class Case:
                 out["energy_wear_coefficient"] = format_quantity(m.energy_wear_coefficient, "energy_wear_coefficient")
             if m.yield_strength is not None:
                 out["yield_strength"] = format_quantity(m.yield_strength, "pressure")
+            if m.fatigue is not None:
+                out["fatigue"] = {k: (format_quantity(v, FATIGUE_SCHEMA[k].kind) if FATIGUE_SCHEMA[k].kind in
+                                      ("pressure", "length") else v)
+                                  for k, v in vars(m.fatigue).items() if v is not None}
             return out
 
         grid: dict = {}
@@ -441,10 +487,12 @@ class Case:
             "solver": {"method": self.solver, "tolerance": self.tolerance},
             "jumping": jumping,
             "grid": grid,
-            "output": {"snapshots": list(self.snapshots) if self.snapshots is not None else "auto"},
-            **({"limits": {k: (float(v) if LIMITS_SCHEMA[k].kind == "fraction" else  # a number: '0.4' is refused
-                               format_quantity(v, LIMITS_SCHEMA[k].kind)) for k, v in self.limits}}
-               if self.limits else {}),
+            "output": {"snapshots": list(self.snapshots) if self.snapshots is not None else "auto",
+                       **({"stresses": True} if self.output_stresses else {})},
+            **({"limits": {**{k: (float(v) if LIMITS_SCHEMA[k].kind == "fraction" else  # a number: '0.4' is refused
+                                  format_quantity(v, LIMITS_SCHEMA[k].kind)) for k, v in self.limits},
+                           **({"crack_initiation": True} if self.crack_limit else {})}}
+               if self.limits or self.crack_limit else {}),
         }
         if self.expected:
             out["expected"] = self.expected
@@ -690,6 +738,21 @@ class _Reader:
             return None
         return tuple(sorted(set(items)))
 
+    def _flag(self, value: Any, spec: Key, path: str) -> Optional[bool]:
+        if not isinstance(value, bool):
+            self.fail(path, f"expected true or false, got {excerpt(value)}")
+            return None
+        return value
+
+    def _fatigue(self, value: Any, spec: Key, path: str):
+        if not isinstance(value, dict):
+            self.fail(path, f"expected a mapping of {', '.join(FATIGUE_SCHEMA)}, got {excerpt(value)}")
+            return None
+        self.unknown(value, FATIGUE_SCHEMA, path)
+        before = len(self.problems)
+        vals = {k: self.key(value, k, sub, f"{path}.{k}") for k, sub in FATIGUE_SCHEMA.items()}
+        return Fatigue(**vals) if len(self.problems) == before else None
+
     def _blocks(self, value: Any, spec: Key, path: str):
         return value  # read item by item by _read_blocks, with the loading's own key specs
 
@@ -873,7 +936,7 @@ def _read_limits(r: "_Reader", raw: Any) -> tuple:
         r.fail("limits", f"expected a mapping of wear limits, e.g. {{max_wear_depth_stationary: 2 um}}, got "
                          f"{excerpt(raw)}")
         return ()
-    r.unknown(raw, LIMITS_SCHEMA, "limits")
+    r.unknown(raw, set(LIMITS_SCHEMA) | {CRACK_LIMIT}, "limits")
     out = []
     for k, spec in LIMITS_SCHEMA.items():
         if k in raw:
@@ -892,6 +955,8 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
     materials = _read_materials(r, raw)
     load, blocks, repeat, spectrum = _read_loading(r, raw)
     limits = _read_limits(r, raw.get("limits"))
+    raw_limits = raw.get("limits") if isinstance(raw.get("limits"), dict) else {}
+    crack_limit = r.key(raw_limits, CRACK_LIMIT, Key("flag", ""), f"limits.{CRACK_LIMIT}") or False
     model, solver, jumping, grid, output = (_read_section(r, raw, section)
                                             for section in ("model", "solver", "jumping", "grid", "output"))
     expected = raw.get("expected", {})
@@ -903,6 +968,7 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
     if mu is None and blocks and all(b.friction_coefficient is not None for b in blocks):
         mu = min(b.friction_coefficient for b in blocks)  # every block gives its own: the history has friction
     _check_model(r, geometry, materials, model, mu)
+    _check_fatigue(r, materials, model, mu, crack_limit, output.get("stresses"))
     domain = grid.get("domain")
     stroke = load.get("stroke")
     if domain is not None and stroke is not None and stroke >= domain[0] / 2:
@@ -926,7 +992,8 @@ def _validate(raw: dict, problems: list, source: str, default_name: str, overrid
                 tolerance=solver["tolerance"], scheme=scheme, step_tolerance=jumping["tolerance"],
                 linear_jump=jumping.get("linear"), eta=jumping["eta"], max_jump=jumping.get("max"), preset=preset,
                 coarse_element=grid.get("coarse_element"), grid_rule=grid["rule"], grid_error=grid["error_estimate"],
-                domain=domain, elements=grid.get("elements"), snapshots=output.get("snapshots"), expected=expected,
+                domain=domain, elements=grid.get("elements"), snapshots=output.get("snapshots"),
+                crack_limit=bool(crack_limit), output_stresses=bool(output.get("stresses")), expected=expected,
                 overrides=overrides, source=source)
 
 
@@ -1023,6 +1090,29 @@ def _scheme(jumping: dict, jumping_raw: dict) -> tuple[Optional[str], Optional[s
         # a block giving only `linear` keeps its original meaning: explicit linear jumping
         scheme = "linear" if jumping.get("linear") is not None and preset is None else DEFAULT_SCHEME
     return scheme, preset
+
+
+def _check_fatigue(r: "_Reader", materials: dict, model: dict, mu: Optional[float], crack_limit, stresses) -> None:
+    """What fretting fatigue needs: the flat's constants (the moving body's half-space is not modelled yet), a
+    friction coefficient (the shear traction drives the cracks), a line contact (the 3D stresses are not wired
+    yet); the crack limit and the stress output need the constants."""
+    if any(path.startswith("materials.stationary.fatigue") for path, _ in r.problems):
+        return  # (already said what is wrong with them)
+    given = {body for body, m in materials.items() if m.fatigue is not None}
+    if "moving" in given:
+        r.fail("materials.moving.fatigue", "the moving body's fatigue is not modelled yet (its stresses need its "
+                                           "own half-space); give the constants for materials.stationary")
+    if "stationary" not in given:
+        for path, on in ((f"limits.{CRACK_LIMIT}", crack_limit), ("output.stresses", stresses)):
+            if on:
+                r.fail(path, "needs materials.stationary.fatigue (the strain-life constants)")
+        return
+    if mu is None or mu == 0:
+        r.fail("materials.stationary.fatigue", "fretting fatigue needs loading.friction_coefficient (> 0): the "
+                                               "shear traction is what opens the cracks")
+    if model.get("dimension") != "2d":
+        r.fail("materials.stationary.fatigue", "fretting fatigue is computed in plane strain only so far (the 3D "
+                                               "stresses are not wired in); set model.dimension: 2d")
 
 
 def _check_model(r: "_Reader", geometry, materials: dict, model: dict, mu: Optional[float]) -> None:

@@ -434,10 +434,13 @@ def _limits(s: dict, c) -> str:
     from fretsim.quantities import shown_unit
     if not c.limits:
         return ""
+
     def shown(key, v):
         kind, unit, f = LIMIT_KEYS[key]
         return f"{v:.1%}" if kind == "fraction" else f"{v * f:.4g} {shown_unit(unit)}"
     limits = dict(c.limits)
+    if s.get("limit_reached") == "crack_initiation":
+        return ""  # (the fatigue sentence says it)
     if s.get("limit_reached"):
         key, n = s["limit_reached"], s["cycles_to_limit"]
         err = s.get("estimated_error_cycles_to_limit", float("nan"))
@@ -450,6 +453,25 @@ def _limits(s: dict, c) -> str:
                                                                   f"fretting)" if hours > 24 * 30 else ""))
         return text + "."
     return f" No wear limit reached within {s['cycles']:,} cycles ({', '.join(f'{k} = {shown(k, v)}' for k, v in limits.items())})."
+
+
+def _fatigue(s: dict, c) -> str:
+    """The fretting-fatigue sentence: when and where a crack starts (or the damage reached), and what comes first."""
+    import math
+    if c.stationary.fatigue is None or "damage_mode" not in s:
+        return ""
+    n, err = s["cycles_to_crack_initiation"], s.get("estimated_error_cycles_to_crack", float("nan"))
+    where = (f"SWT peak {s['swt_max_MPa']:.3g} MPa at x = {s['swt_location_x_mm'] * 1e3:.4g} µm, "
+             f"{s['swt_depth_um']:.3g} µm deep")
+    if math.isfinite(n):
+        text = (f" Fretting fatigue: a crack starts at cycle {n:,.0f}" + (f" (± {err:.1e} relative)" if
+                                                                          math.isfinite(err) else "")
+                + f" at x = {s['crack_location_x_mm'] * 1e3:.4g} µm ({where})")
+    else:
+        text = (f" Fretting fatigue: no crack within the run (Miner's sum reached {s['fatigue_damage']:.3g} of 1; "
+                f"{where})")
+    return text + f"; damage mode: {s['damage_mode']}" + (" (the run stopped there)." if s.get("limit_reached") ==
+                                                          "crack_initiation" else ".")
 
 
 def _said(outcome) -> str:
@@ -485,7 +507,7 @@ def _paragraph(outcome) -> str:
                  f"{s['centre_wear_depth_moving_um']:.3g} µm (max {s['max_wear_depth_moving_um']:.3g} µm), volume "
                  f"{s['wear_volume_moving_mm3']:.4g} mm³. Volume against its invariant "
                  f"({outcome.setup.cycle.invariant}): {s['archard_volume_error']:.1e}. "
-                 + _estimates(s) + _limits(s, c))
+                 + _estimates(s) + _limits(s, c) + _fatigue(s, c))
     else:
         text += f" Contact only: peak pressure {s['max_pressure_MPa']:.4g} MPa."
     return text + f" Results: {outcome.output}"

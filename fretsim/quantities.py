@@ -111,6 +111,21 @@ SUMMARY: dict[str, Figure] = {
     "time_to_limit_h": Figure("h", nan=True),  # ... or no loading.frequency
     "estimated_error_cycles_to_limit": Figure("1", nan=True),
     "grid_error_wall_time_s": Figure("s"),
+    # fretting fatigue of the flat (materials.stationary.fatigue; absent otherwise): the largest over the fatigue
+    # states, the crack-initiation cycle (NaN: beyond the run) and which damage comes first
+    "max_shear_stress_MPa": Figure("MPa"),
+    "max_shear_stress_depth_um": Figure("um"),
+    "max_surface_tensile_stress_MPa": Figure("MPa"),
+    "swt_max_MPa": Figure("MPa"),
+    "swt_location_x_mm": Figure("mm"),
+    "swt_depth_um": Figure("um"),
+    "ruiz_max": Figure("MPa^2*mm"),
+    "cycles_to_crack_initiation": Figure("cycles", nan=True),
+    "crack_location_x_mm": Figure("mm", nan=True),
+    "fatigue_damage": Figure("1"),
+    "damage_mode": Figure(""),
+    "estimated_error_cycles_to_crack": Figure("1", nan=True),  # no crack in the run or its companion, or none run
+    "estimated_error_swt_max": Figure("1", nan=True),
 }
 SUMMARY_WEAR = ("max_wear_depth_moving", "max_wear_depth_stationary", "centre_wear_depth_moving",
                 "centre_wear_depth_stationary", "scar_width_stationary", "scar_width_moving", "wear_volume_moving",

@@ -436,6 +436,8 @@ def _summary(setup, counter, t0) -> dict:
     out = summarize(setup, counter.last, counter.solves, _elapsed(counter, t0), counter.errors)
     out.update(counter.extra or {**{k: float("nan") for k in grid_error.KEYS + (grid_error.LIMIT_KEY,)},
                                  "grid_error_wall_time_s": 0.0})
+    if setup.fatigue is not None:  # not estimated (no companion, or it stopped): said so, not left out
+        out.update({k: out.get(k, float("nan")) for k in grid_error.FATIGUE_KEYS})
     return in_summary_order(out)
 
 
@@ -462,6 +464,8 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
                                      c_setup.grid, coarsest)
     out = grid_error.totals(summary, part, model_part)
     out[grid_error.LIMIT_KEY] = grid_error.cycles_to_limit_estimate(summary, coarse, counter.last.limit, model_part)
+    if setup.fatigue is not None:
+        out.update(grid_error.fatigue_estimates(summary, coarse))
     if counter.last.limit is not None and not math.isfinite(out[grid_error.LIMIT_KEY]):
         counter.notes.append("the grid's part of cycles_to_limit was not estimated: the companion run on a grid "
                              "twice as coarse reached no limit within loading.cycles")

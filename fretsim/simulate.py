@@ -22,7 +22,10 @@ import numpy as np
 
 from fretsim.compliance import add
 from fretsim.cycle import Cycle, CycleError
+from fretsim.cycle.result import TRACTIONS
 from fretsim.errors import DomainError, NumericalFailure, PhysicalLimit, ResolutionError, SimulationError
+from fretsim.fatigue.damage import Miner, evaluate
+from fretsim.fatigue.damage import summary as fatigue_summary
 from fretsim.geometry import Limits
 from fretsim.grid import Grid
 from fretsim.loading import Loading
@@ -75,6 +78,7 @@ class Setup:
     wall: Optional[float] = None  # mm, a tube's wall thickness (the wall_loss limit)
     limit_tolerance: float = 1e-3  # relative: the crossing cycle of a limit is found to this
     frequency: Optional[float] = None  # Hz: the time to a limit
+    fatigue: Optional[object] = None  # fretting fatigue of the flat (fretsim.fatigue.damage.FatigueSpec), opt-in
 
     @property
     def solve_grid(self) -> Grid:
@@ -114,6 +118,7 @@ class Step:
     energy: float = 0.0  # the energy dissipated by friction from cycle 0 to this one, N·mm (NaN: no μ)
     block: int = 0  # the loading's block whose cycles led to this state (0 at the start)
     limit: Optional[tuple] = None  # (key, crossing cycle, its interpolation spread): the wear limit reached here
+    fatigue: Optional[object] = None  # the flat's fatigue at this state (fretsim.fatigue.damage.FatigueState)
     state: dict = field(default_factory=dict)  # the loop's checkpoint after this step (for resuming)
 
 
@@ -149,7 +154,9 @@ class _Loop:
         self.observers = observers
         self.progress = progress
         self.t0 = time.perf_counter()
-        self.base_stops = sorted(set(setup.snapshots) | {setup.cycles} | set(setup.loading.boundaries))
+        self.detailed = set(setup.snapshots) | (set(setup.fatigue.states) if setup.fatigue is not None else set())
+        fatigue = {n for n in setup.fatigue.states if n <= setup.cycles} if setup.fatigue is not None else set()
+        self.base_stops = sorted(set(setup.snapshots) | fatigue | {setup.cycles} | set(setup.loading.boundaries))
         self.stops = list(self.base_stops)  # and, with wear limits, the crossings a retaken step lands on
         # block ends that are not also recorded states (snapshots, the last cycle)
         self.boundaries = set(setup.loading.boundaries) - set(setup.snapshots) - {setup.cycles}
@@ -176,6 +183,7 @@ class _Loop:
         self.batch: list = []  # adaptive scheme: (wear m, wear s, work, energy) at the last linear steps
         self.watch = GrowthWatch()
         self._summed = (None, None, None)  # (extra, compliance, their sum) of the last implicit solve
+        self.miner = Miner() if setup.fatigue is not None else None  # the flat's fatigue damage so far
 
     def restore(self, st: dict) -> None:
         checkpoint.restore(self, st)
@@ -209,7 +217,7 @@ class _Loop:
         checks.check_edges(p, s.band, s.grid, cycle, s.y_edges_free)
         return p, res
 
-    def cycle_at(self, cycle: int, guess, h_m=None, h_s=None, implicit: float = 0.0) -> Cycle:
+    def cycle_at(self, cycle: int, guess, h_m=None, h_s=None, implicit: float = 0.0, detail: bool = False) -> Cycle:
         """One representative cycle at the wear (h_m, h_s) (default: the current state).
 
         With ``implicit`` = s > 0 it is an implicit step's: the contact anticipates s cycles of its own wear, so the
@@ -218,7 +226,8 @@ class _Loop:
         try:
             return self.model.solve(self.h_m if h_m is None else h_m, self.h_s if h_s is None else h_s, self.normal,
                                     guess, step=implicit, memory=self.memory, cycle=cycle,
-                                    detail=cycle in self.s.snapshots)
+                                    detail=detail or cycle in self.s.snapshots or (
+                                        TRACTIONS if cycle in self.detailed else False))
         except CycleError as exc:
             raise NumericalFailure(f"{exc} at cycle {cycle}", self.n) from None
 
@@ -250,6 +259,10 @@ class _Loop:
         if verdict == "reached":
             step.is_snapshot = True  # the state at the limit is what the engineer looks at
             step.limit = self.reached = self.landing.reached()
+        if self.miner is not None and self._fatigue(step) and verdict != "reached":
+            verdict = "reached"  # limits.crack_initiation: the run ends at the state where the damage reached 1
+            step.is_snapshot = True
+            step.limit = self.reached = ("crack_initiation", self.miner.crack[0], self.n - self.miner.crack[0], 1.0)
         step.state = checkpoint.state(self)
         self.last_state = step.state
         for obs in self.observers:
@@ -260,6 +273,21 @@ class _Loop:
             raise Reached(step)
         checks.check_body(s.limits, s.grid, self.h_m, self.p, self.n)
         return step
+
+    def _fatigue(self, step: Step) -> bool:
+        """The flat's fatigue at a detailed state (or at a wear limit's, detailed now) added to Miner's sum; True
+        where it just reached 1 and the case stops there."""
+        s, cyc = self.s, step.cycle_result
+        if self.miner.damage is not None and self.n <= self.miner.cycle:
+            return False  # (a resumed run's first state: counted already)
+        if cyc.tractions is None:
+            if not step.is_snapshot:
+                return False
+            cyc = self.cycle_at(self.n, self.p, detail=True)
+        step.fatigue = evaluate(s.fatigue, s.grid.x, s.grid.dx, s.fatigue.curve.youngs_modulus, cyc)
+        had = self.miner.crack is not None
+        self.miner.add(self.n, step.fatigue)
+        return s.fatigue.crack_limit and not had and self.miner.crack is not None
 
     def restored_cycle(self) -> Cycle:
         """The cycle at the restored state: rebuilt from its pressure where the rates are linear in it, else solved
@@ -388,4 +416,6 @@ def summarize(setup: Setup, step: Step, solves: int, wall_time: float, max_error
         "cycles_to_limit": float(step.limit[1]) if step.limit else float("nan"),
         "time_to_limit_h": (float(step.limit[1]) / setup.frequency / 3600.0 if step.limit and setup.frequency
                             else float("nan")),
+        **(fatigue_summary(setup.fatigue, step.state, setup.grid.x, step.limit) if setup.fatigue is not None
+           else {}),
     }

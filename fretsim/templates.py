@@ -8,7 +8,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from fretsim.case import LIMITS_SCHEMA, GEOMETRY_KEYS, REQUIRED, SCHEMA, Key
+from fretsim.case import FATIGUE_SCHEMA, LIMITS_SCHEMA, GEOMETRY_KEYS, REQUIRED, SCHEMA, Key
 from fretsim.units import INTERNAL
 
 CASES = Path(__file__).resolve().parent / "cases"
@@ -87,6 +87,12 @@ def case_reference_markdown() -> str:
     lines += ["| `loading.blocks[i]` / `loading.spectrum[i]` | – | – | a mapping | normal_load, stroke and cycles "
               "(blocks) or fraction (spectrum, of loading.cycles), and friction_coefficient where it differs; "
               "with blocks, loading.normal_load and loading.stroke are not given |"]
+    for key, spec in FATIGUE_SCHEMA.items():
+        lines.append(f"| `materials.stationary.fatigue.{key}` | {_unit(spec)} | {_default(spec)} | {_allowed(spec)} | "
+                     f"{spec.help} |")
+    lines.append("| `limits.crack_initiation` | – | false | true, false | with materials.stationary.fatigue: the run "
+                 "stops at the fatigue state where Miner's sum first reaches 1, and reports limit_reached "
+                 "crack_initiation and cycles_to_crack_initiation |")
     for key, spec in LIMITS_SCHEMA.items():
         lines.append(f"| `limits.{key}` | {_unit(spec)} | {_default(spec)} | {_allowed(spec)} | a wear limit: "
                      f"{spec.help}; the run stops where the first limit is reached and reports limit_reached, "
@@ -111,6 +117,10 @@ def template_text(kind: str) -> str:
     for body in ("moving", "stationary"):
         out.append(f"  {body}:")
         for key, spec in SCHEMA["material"].items():
+            if spec.kind == "fatigue":  # an opt-in mapping: shown, commented out, with its keys
+                keys = ", ".join(f"{k}: {v.example}" for k, v in FATIGUE_SCHEMA.items() if v.default is REQUIRED)
+                out.append(f"    # fatigue: {{{keys}}}   # {spec.help}")
+                continue
             example = spec.example if not (body == "stationary" and key == "wear_coefficient") else "3.0e-8 1/MPa"
             out.append(f"    {key + ': ' + example:<29} # {spec.help}")
     for section in ("loading", "model", "solver", "jumping", "grid", "output"):

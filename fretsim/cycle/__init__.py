@@ -56,8 +56,9 @@ class FrettingCycle(Protocol):
 
     def solve(self, wear_moving: np.ndarray, wear_stationary: np.ndarray, normal: Normal,
               guess: Optional[np.ndarray], step: float = 0.0, memory: Optional[dict] = None,
-              cycle: int = 0, detail: bool = True) -> Cycle:
-        """``detail``: the state will be recorded, so draw what is only drawn (the loop's shape) in full."""
+              cycle: int = 0, detail: bool | str = True) -> Cycle:
+        """``detail``: the state will be recorded, so draw what is only drawn (the loop's shape) in full, and give
+        the tractions round the loop (``Cycle.tractions``); ``TRACTIONS``: the tractions only (a fatigue state)."""
 
     def describe(self) -> str:
         """The cycle model in a few words, for a run's one-paragraph summary."""

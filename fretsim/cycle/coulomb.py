@@ -44,7 +44,7 @@ import numpy as np
 
 from fretsim.compliance import scaled
 from fretsim.cycle.loop import LOOP_SIDE_INCREMENTS, elastic_side, loop_path, turning_loop
-from fretsim.cycle.result import Cycle, CycleError, CycleSpec, stick_half_width
+from fretsim.cycle.result import TRACTIONS, Cycle, CycleError, CycleSpec, stick_half_width
 from fretsim.grid import Grid
 from fretsim.solvers.tangential import solve_tangential
 from fretsim.wear import Sweep, gap_wear, sweep_read, wear_operator
@@ -60,6 +60,8 @@ RESOLVED_CORRECTIONS = 3  # ... for the resolved stroke, where the linear operat
 #                           position) is further from each position's real wear: each pass cuts the step's bias
 #                           about 5× (McColl 185 N 2D at 1 000 cycles, BDF2 against the run cycle by cycle: +1.9 %,
 #                           +0.26 %, +0.025 % after 0, 1, 3; estimate 0.031 %: scripts/results/resolved_stepping.txt)
+FATIGUE_SIDE_INCREMENTS = 4  # each elastic side of a fatigue state's cycle (not recorded): the flat's stresses
+#                              over the side move between its ends (the SWT field as with 12: scripts/study_fatigue.py)
 TRAVEL_TOLERANCE = 0.1  # of an element: a resolved increment is solved again where a point's predicted travel was off
 #                         by more (the pressure follows the worn flat on that scale)
 
@@ -185,6 +187,8 @@ class CoulombCycle:
         tally = _Tally(shape, self.grid.area * self.volume_factor)
         q, s = np.zeros(shape), np.zeros(shape)
         fine = max(LOOP_SIDE_INCREMENTS, self.increments)  # model.increments asks for a finer loop, never coarser
+        if detail == TRACTIONS:  # a fatigue state, not recorded: the tractions need the sides' ends, not their shape
+            fine = FATIGUE_SIDE_INCREMENTS
         path = (loop_path(self.stroke, self._elastic_side(fixed[0]), fine) if detail and not self.resolved
                 and not self.rigid else self.path(n))
         first = next(k for k, step in enumerate(path) if step[2])  # the loop's first increment (after the quarter)
@@ -193,10 +197,13 @@ class CoulombCycle:
         end = max(k for k in range(first, len(path)) if path[k][1] > path[k][0])
         p_prev, ds_prev, du_prev = guess, None, None
         visits = []  # an implicit resolved step's (pressure, travel) at each increment, for its mismatch
+        states = [] if detail and not corrected else None  # the tractions round the loop (fretting fatigue)
         for k, (u0, u1, counted) in enumerate(path):
             if k == first:
                 tally.loop(u0, q)
                 q_low, p_low = q, p_prev
+                if states is not None:
+                    states.append((p_prev if p_prev is not None else fixed[0], q, s))
             du = u1 - u0
             if self.resolved:
                 shift = correction[k] if correction is not None else None
@@ -211,6 +218,8 @@ class CoulombCycle:
             if counted:
                 tally.add(self, p, q_new, s, ds, abs(du) / (4.0 * self.stroke))
                 tally.loop(u1, q_new)
+                if states is not None:
+                    states.append((p, q_new, s + ds))
             if k == mid:
                 p_mid, res_mid, travel_mid = p, res, (s, s + ds)
             if k == end:
@@ -218,7 +227,7 @@ class CoulombCycle:
                 q_high, p_high = q_new, p
             s, q = s + ds, q_new
             p_prev, ds_prev, du_prev = p, ds, du
-        if self.resolved and detail and not self.rigid and not corrected:  # (a corrected pass is not returned)
+        if self.resolved and detail is True and not self.rigid and not corrected:  # (a corrected pass: not returned)
             tally.loop_u, tally.loop_q = turning_loop(self.stroke, fine, self._tangential, self._elastic_side,
                                                       (q_low, p_low), (q_high, p_high), tally.area)
         defect, mismatch = 0.0, None
@@ -228,7 +237,10 @@ class CoulombCycle:
                                             correction)
             if self.resolved and corrected:
                 mismatch = _mismatches(visits, tally, step, w_lin, self.grid.dx, self.kernel)
-        return tally.cycle(self, p_mid, res_mid, stick_end, defect, mismatch)
+        cyc = tally.cycle(self, p_mid, res_mid, stick_end, defect, mismatch)
+        if states:
+            cyc.tractions = tuple(np.array(a) for a in zip(*states))
+        return cyc
 
     def _resolved_increment(self, wear_moving, wear_stationary, normal, q, s, du, p_prev, ds_prev, du_prev, extra,
                             cycle: int, tally: "_Tally", shift=None):
@@ -276,7 +288,7 @@ class CoulombCycle:
                                 gap_wear(np.zeros(shape), tally.rate_s, dx, self.stroke, self.gap_model))
         deepest = np.unravel_index(np.argmax(wear_moving + wear_stationary), shape)
         mismatch = step * (found - w_lin(p_mid))
-        defect = abs(float(self._response(step, w_lin, mismatch - (correction if correction is not None else 0))
+        defect = abs(float(_response(self.compliance, step, w_lin, mismatch - (correction if correction is not None else 0))
                            [deepest]))
         return defect, mismatch
 
@@ -304,14 +316,6 @@ class CoulombCycle:
         ds = rhs - self.tangential(q_new)  # ΔU − KΔq everywhere (rhs = Kq + ΔU)
         ds[rows, cols] = np.where(on[rows, cols], res.slip, ds[rows, cols])  # in contact: the solver's, 0 where stuck
         return q_new, ds, stuck, res.iterations
-
-    def _response(self, step: float, w_lin, mismatch: np.ndarray) -> np.ndarray:
-        """What a gap mismatch does to the wear of an implicit step: s·W(C + s·W)⁻¹ applied by Fourier symbols
-        (the contact set ignored), so a smooth mismatch, which the pressure absorbs, counts little."""
-        conv = getattr(self.compliance, "convolution", None)
-        c_hat = conv.hat if conv is not None else self.compliance.hat
-        w_hat = step * w_lin.hat
-        return w_lin.backward(w_lin.forward(mismatch) * (w_hat / (c_hat + w_hat)))
 
 
 class _Tally:
@@ -363,6 +367,15 @@ class _Tally:
             iterations=self.iterations, loop=(np.array(self.loop_u), np.array(self.loop_q)),
             memory={"slip_lin": max(s_max, 1e-300), "slip_spread": 1.0 - s_mean / s_max if s_max > 0 else 1.0},
             defect=defect, mismatch=mismatch, stick=stick_end if stick_end.any() else None)
+
+
+def _response(compliance, step: float, w_lin, mismatch: np.ndarray) -> np.ndarray:
+    """What a gap mismatch does to the wear of an implicit step: s·W(C + s·W)⁻¹ applied by Fourier symbols (the
+    contact set ignored), so a smooth mismatch, which the pressure absorbs, counts little."""
+    conv = getattr(compliance, "convolution", None)
+    c_hat = conv.hat if conv is not None else compliance.hat
+    w_hat = step * w_lin.hat
+    return w_lin.backward(w_lin.forward(mismatch) * (w_hat / (c_hat + w_hat)))
 
 
 def _mismatches(visits: list, tally: _Tally, step: float, w_lin, dx: float, kernel: str) -> list:

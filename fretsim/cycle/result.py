@@ -12,6 +12,7 @@ from fretsim.loading import Block
 from fretsim.solvers.result import ContactResult
 
 REGIMES = ("partial_slip", "gross_slip")
+TRACTIONS = "tractions"  # ``detail`` of a state detailed for its tractions only (fatigue), not recorded
 
 
 class CycleError(Exception):
@@ -42,6 +43,9 @@ class Cycle:
     stick: Optional[np.ndarray] = None  # elements that stuck through the end of the up-stroke (partial slip)
     mismatch: Optional[np.ndarray] = None  # implicit steps of a non-linear member: the gap growth found − anticipated
     defect: float = 0.0  # implicit steps: |wear the solve anticipated − wear found| at the deepest element (mm)
+    # a detailed cycle (a recorded or fatigue state): the moving body's pressure, shear traction (MPa) and each
+    # point's travel over the flat (mm) at the loop's start and the end of each increment, arrays (state, ny, nx)
+    tractions: Optional[tuple] = None
 
 
 @dataclass(frozen=True)

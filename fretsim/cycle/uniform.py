@@ -22,6 +22,10 @@ from fretsim.wear import archard_volume, gap_wear, stroke_average, wear_operator
 from fretsim.wear_laws import gross_slip_coefficients
 
 
+SAMPLES = 1  # increments per half-stroke of a detailed cycle's tractions: the contact slides rigidly with them
+#             fixed, which the fatigue counts over every position on the way (fretsim.fatigue.damage.slides)
+
+
 @dataclass(frozen=True)
 class UniformCycle:
     """The paper's cycle.  ``k_moving``/``k_stationary`` are the coefficients of p·ds in the wear law (Archard's k,
@@ -74,7 +78,21 @@ class UniformCycle:
               cycle: int = 0, detail: bool = True) -> Cycle:
         seen = gap_wear(wear_moving, wear_stationary, self.grid.dx, self.stroke, self.gap_model)
         p, res = normal(seen, guess, scaled(self.wear_op, step) if step else None, load=self.load, cycle=cycle)
-        return self._cycle(p, res)
+        cyc = self._cycle(p, res)
+        if detail and self.friction_coefficient:
+            cyc.tractions = self.tractions(p)
+        return cyc
+
+    def tractions(self, p: np.ndarray) -> tuple:
+        """The loop's tractions (Cycle.tractions): the mid-stroke pressure carried rigidly along the stroke, the
+        shear μp along the motion, reversed at each end (gross slip everywhere), at SAMPLES positions per half."""
+        d, mu = self.stroke, self.friction_coefficient
+        up = np.linspace(-d, d, SAMPLES + 1)
+        travel = np.concatenate([up, up[::-1]])
+        sign = np.concatenate([np.ones(SAMPLES + 1), -np.ones(SAMPLES + 1)])
+        n = travel.size
+        return (np.broadcast_to(p, (n,) + p.shape).copy(), sign[:, None, None] * (mu * p)[None],
+                np.broadcast_to(travel[:, None, None], (n,) + p.shape).copy())
 
     def restore(self, pressure: np.ndarray) -> Cycle:
         """The cycle of a mid-stroke pressure read back from a checkpoint (no solve: everything follows from p)."""

@@ -23,6 +23,9 @@ import functools
 from typing import Optional
 
 from fretsim.case import Case
+from fretsim.fatigue.damage import FatigueSpec, fatigue_states
+from fretsim.fatigue.history import depths
+from fretsim.fatigue.swt import Basquin
 from fretsim.plan import cycle, grid, inputs, model, stepping
 from fretsim.plan.choices import Choice, Plan, show
 from fretsim.plan.cost import estimate_cost, estimate_solves
@@ -69,11 +72,11 @@ def prepare(case: Case, allow_unstable: bool = False, runs: Optional[SideRuns] =
     grid.warn_unresolved_stick(case, plan, regime.slip.value, regime.transition, contact, grids.grid)
     cycles = cycle.build(case, plan, grids, operators, regime, proxy_case, runs, plan_case)
     steps = stepping.build(case, plan, grids, operators, cycles, allow_unstable)
-    return _setup(case, plan, grids, operators, regime, cycles, steps), _filled(case, grids, operators, cycles,
+    return _setup(case, plan, grids, operators, regime, cycles, steps, contact), _filled(case, grids, operators, cycles,
                                                                                  steps), plan
 
 
-def _setup(case: Case, plan: Plan, grids, operators, regime, cycles, steps) -> Setup:
+def _setup(case: Case, plan: Plan, grids, operators, regime, cycles, steps, contact) -> Setup:
     """The loop's setup: arrays, numbers, operators, the loading and the members."""
     g, members = case.geometry, cycles.members
     first = members[0]
@@ -90,7 +93,29 @@ def _setup(case: Case, plan: Plan, grids, operators, regime, cycles, steps) -> S
                  coarse_gap=operators.coarse_gap, per_cycle=steps.per_cycle,
                  gross_slip_stroke=regime.transition if regime.transition is not None else float("nan"),
                  regime_block=regime.block if regime.transition is not None else None,
-                 notes=_notes(plan))
+                 notes=_notes(plan), fatigue=_fatigue(case, grids.grid, steps.snapshots, contact))
+
+
+def _fatigue(case: Case, grid, snapshots: tuple, contact) -> Optional[FatigueSpec]:
+    """The flat's fatigue, where the case gives its constants: the curve (its endurance limit, a stress amplitude,
+    as the SWT σ_e²/E it stands for), the depths — to four unworn Hertz half-widths and the stroke's reach twice,
+    the region the moving load sweeps, fixed for the run so that the damage adds up at the same points — and
+    the states (those on the way to each recorded state's end)."""
+    flat = case.stationary
+    f = flat.fatigue
+    if f is None:
+        return None
+    e = flat.youngs_modulus
+    curve = Basquin(f.strength_coefficient, f.strength_exponent, f.ductility_coefficient, f.ductility_exponent, e,
+                    endurance_limit=None if f.endurance_limit is None else f.endurance_limit ** 2 / e)
+    deepest = 4.0 * contact.hertz.half_width_x + 2.0 * case.loading.peak_stroke
+    if f.critical_distance is not None:
+        deepest = max(deepest, 2.0 * f.critical_distance)
+    ends = {case.loading.cycles} | {max(snapshots, default=0)}
+    states = sorted(set().union(*(fatigue_states(n, snapshots) for n in ends)))
+    return FatigueSpec(curve=curve, poisson=flat.poissons_ratio, depths=depths(grid.dx, deepest),
+                       critical_distance=f.critical_distance, states=tuple(states), crack_limit=case.crack_limit,
+                       keep_stresses=case.output_stresses)
 
 
 def _notes(plan: Plan) -> tuple:

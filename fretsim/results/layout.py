@@ -1,6 +1,8 @@
 """The results file's layout: its format versions, and what each step and snapshot writes, with units."""
 from __future__ import annotations
 
+import numpy as np
+
 from fretsim.quantities import SUMMARY, WEAR
 
 FORMAT_VERSION = "1.5"
@@ -61,6 +63,18 @@ FIELDS = {
     "shear_traction": ("MPa", "amplitude of the shear traction on the moving body over the cycle (NaN: not "
                               "modelled)", lambda s: s.cycle_result.shear),
 }
+# fretting fatigue (materials.stationary.fatigue): the flat's fields below its surface at the recorded states, over
+# (cycle, z, x) with /fields/z the depths; the stresses only with output.stresses.  Absent without fatigue.
+SUBSURFACE = {
+    "swt": ("MPa", "Smith-Watson-Topper parameter on the critical plane below the stationary body's surface",
+            lambda f: f.swt),
+    "swt_plane_angle": ("deg", "the critical plane's normal, from the sliding direction x towards the depth z",
+                        lambda f: np.degrees(f.angle)),
+}
+STRESSES = {
+    f"stress_{c}": ("MPa", f"the stationary body's stress σ_{c} below its surface: its value of largest magnitude "
+                           f"over the cycle (signed)", lambda f, i=i: f.stresses[i])
+    for i, c in enumerate(("xx", "zz", "xz"))}
 FIELDS_V12 = [k for k in FIELDS if not k.startswith(("slip_distance", "shear"))]
 NAN_FIELDS = {"shear_traction"}  # the uniform model without a friction coefficient does not know it
 SUMMARY_UNITS = {key: figure.unit for key, figure in SUMMARY.items()}

@@ -19,7 +19,7 @@ import h5py
 import numpy as np
 
 from fretsim import __version__
-from fretsim.results.layout import FIELDS, FORMAT_VERSION, HISTORY, INTEGER_HISTORY, SUMMARY_UNITS, summary_long_name
+from fretsim.results.layout import FIELDS, FORMAT_VERSION, STRESSES, SUBSURFACE, HISTORY, INTEGER_HISTORY, SUMMARY_UNITS, summary_long_name
 from fretsim.results.seal import USERBLOCK, _SealingWriter, checkpoint_digest, seal_image
 from fretsim.results.reader import Results
 
@@ -62,6 +62,10 @@ class ResultsWriter:
             self.rows, self.fields, self.field_cycles = [], {k: [] for k in FIELDS}, []
             self.loops = []  # (applied displacement um, tangential force N) at each snapshot
         self.regrids = list(regrids)  # the automatic grid's widenings (fretsim.regrid.Regrid)
+        # fretting fatigue's fields below the flat at each snapshot, each (layers, 1, x), and the layers' depths
+        self.depths = previous.subsurface.get("z") if previous is not None else None
+        self.subsurface = ({k: [a[:, None, :] for a in v] for k, v in previous.subsurface.items() if k != "z"}
+                           if previous is not None else {})
         self.status, self.message, self.summary = "running", "", {}
         self.state: Optional[dict] = None
         self._flushed = -math.inf
@@ -75,6 +79,8 @@ class ResultsWriter:
             self.field_cycles.append(step.cycle)
             for name, (_, _, get) in FIELDS.items():
                 self.fields[name].append(np.array(get(step)))
+            if setup.fatigue is not None:
+                self._add_subsurface(setup, step)
             loop = step.cycle_result.loop
             self.loops.append((loop[0] * 1e3, loop[1]) if loop is not None else (np.zeros(0), np.zeros(0)))
         self.state = step.state
@@ -88,12 +94,22 @@ class ResultsWriter:
         if now - self._flushed > max(FLUSH_SECONDS, FLUSH_COST_FACTOR * self._flush_cost):
             self.flush()
 
+    def _add_subsurface(self, setup, step) -> None:
+        """The flat's fields below its surface at a snapshot (NaN where the state had no fatigue evaluated)."""
+        self.depths = setup.fatigue.depths
+        tables = {**SUBSURFACE, **(STRESSES if setup.fatigue.keep_stresses else {})}
+        for name, (_, _, get) in tables.items():
+            shape = (len(self.depths), 1, setup.grid.shape[1])
+            value = np.asarray(get(step.fatigue)) if step.fatigue is not None else np.full(shape, np.nan)
+            self.subsurface.setdefault(name, []).append(value.reshape(shape))
+
     def regrid(self, r, grid, case_yaml: str, choices, notes) -> None:
         """The run moved onto a widened grid (:mod:`fretsim.regrid`): the snapshots so far are padded onto it (the
         new elements were unworn and unloaded), the case and choices are the ones it now runs (a resume plans this
         grid), and the widening is recorded."""
         from fretsim.regrid import pad  # (the results package does not depend on the loop's modules otherwise)
         self.fields = {k: [pad(a, r) for a in v] for k, v in self.fields.items()}
+        self.subsurface = {k: [pad(a, r) for a in v] for k, v in self.subsurface.items()}
         self.grid, self.case_yaml, self.choices, self.notes = grid, case_yaml, tuple(choices), tuple(notes)
         self.regrids.append(r)
 
@@ -201,9 +217,11 @@ class ResultsWriter:
             ds = w.dataset(fl, name, data, units=units, long_name=long_name)
             for axis, scale in enumerate(scales):
                 ds.dims[axis].attach_scale(scale)
+        if self.subsurface:
+            _write_subsurface(self, w, fl, scales)
         self._write_loops(w, f)
         if self.regrids:
-            self._write_regrids(w, f)
+            _write_regrids(self, w, f)
         s = w.group(f, "summary")
         for key, value in self.summary.items():
             w.dataset(s, key, value, units=SUMMARY_UNITS.get(key, "1"), long_name=summary_long_name(key))
@@ -238,24 +256,6 @@ class ResultsWriter:
             ds = w.dataset(lp, name, data, units=units, long_name=long_name)
             ds.dims[0].attach_scale(lcyc)
 
-    def _write_regrids(self, w: "_SealingWriter", f: h5py.File) -> None:
-        g = w.group(f, "regrids")
-        w.attrs(g, long_name="each widening of the automatic grid: the earlier snapshots are padded onto the last "
-                             "grid with zeros (the new elements were unworn and unloaded)")
-        rs = self.regrids
-        w.dataset(g, "cycle", np.array([r.cycle for r in rs], dtype="i8"), units="cycles",
-                  long_name="the state the run went back to and continued from on the wider grid")
-        for i, axis in enumerate("xy"):
-            for when in ("old", "new"):
-                w.dataset(g, f"{when}_elements_{axis}", np.array([getattr(r, f"{when}_elements")[i] for r in rs],
-                                                                 dtype="i8"), units="1",
-                          long_name=f"elements along {axis} {'before' if when == 'old' else 'after'}")
-                w.dataset(g, f"{when}_domain_{axis}", np.array([getattr(r, f"{when}_domain")[i] for r in rs],
-                                                               dtype=float), units="mm",
-                          long_name=f"extent along {axis} {'before' if when == 'old' else 'after'}"
-                                    f"{' (1 in 2D: the plane-strain row)' if axis == 'y' else ''}")
-        w.dataset(g, "reason", [r.reason for r in rs], h5py.string_dtype())
-
     def _write_inputs(self, w: "_SealingWriter", f: h5py.File) -> None:
         g = w.group(f, "inputs")
         for key, (value, units, long_name) in self.inputs.get("values", {}).items():
@@ -263,6 +263,40 @@ class ResultsWriter:
                       long_name=long_name)
         w.attrs(g, overrides=json.dumps(list(self.inputs.get("overrides", []))),
                 case_file=str(self.inputs.get("case_file", "")))
+
+
+def _write_subsurface(writer: "ResultsWriter", w: "_SealingWriter", fl, scales: list) -> None:
+    """/fields/z and the fatigue fields over (cycle, z, x): a line contact's y (one row) dropped."""
+    z = w.dataset(fl, "z", np.asarray(writer.depths, dtype=float), units="mm",
+                  long_name="depth below the stationary body's surface")
+    z.make_scale("z")
+    for name, values in writer.subsurface.items():
+        units, long_name, _ = {**SUBSURFACE, **STRESSES}[name]
+        data = np.array(values, dtype=float).reshape(len(values), len(writer.depths), -1)
+        ds = w.dataset(fl, name, data, units=units, long_name=long_name)
+        for axis, scale in enumerate((scales[0], z, scales[-1])):
+            ds.dims[axis].attach_scale(scale)
+
+
+
+def _write_regrids(writer: "ResultsWriter", w: "_SealingWriter", f: h5py.File) -> None:
+    g = w.group(f, "regrids")
+    w.attrs(g, long_name="each widening of the automatic grid: the earlier snapshots are padded onto the last "
+                         "grid with zeros (the new elements were unworn and unloaded)")
+    rs = writer.regrids
+    w.dataset(g, "cycle", np.array([r.cycle for r in rs], dtype="i8"), units="cycles",
+              long_name="the state the run went back to and continued from on the wider grid")
+    for i, axis in enumerate("xy"):
+        for when in ("old", "new"):
+            w.dataset(g, f"{when}_elements_{axis}", np.array([getattr(r, f"{when}_elements")[i] for r in rs],
+                                                             dtype="i8"), units="1",
+                      long_name=f"elements along {axis} {'before' if when == 'old' else 'after'}")
+            w.dataset(g, f"{when}_domain_{axis}", np.array([getattr(r, f"{when}_domain")[i] for r in rs],
+                                                           dtype=float), units="mm",
+                      long_name=f"extent along {axis} {'before' if when == 'old' else 'after'}"
+                                f"{' (1 in 2D: the plane-strain row)' if axis == 'y' else ''}")
+    w.dataset(g, "reason", [r.reason for r in rs], h5py.string_dtype())
+
 
 
 def _fsync_dir(directory: Path) -> None:

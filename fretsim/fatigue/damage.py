@@ -1,0 +1,269 @@
+"""Fretting fatigue over the wear history: the flat's SWT field at each fatigue state, its crack-initiation life,
+and Miner's sum of the damage over the cycles as the wear changes the contact.
+
+At a fatigue state (a cycle the loop details: :data:`Setup.fatigue`'s ``states``) the cycle's tractions give the
+flat's stresses over the cycle (:mod:`.history`), the SWT parameter on each point's critical plane
+(:func:`fretsim.fatigue.swt.swt_search`) and the life N_i it would have if the contact stayed as it is now
+(:meth:`fretsim.fatigue.swt.Basquin.lives`).  With a critical distance L the parameter is averaged over the
+depth L below each surface point first (the line method) and the damage is counted per surface point.
+
+Between two fatigue states the damage rate 1/N_i of each point is taken linear in the cycles (the trapezoid
+rule): D += ½(1/N_i,before + 1/N_i,after)·ΔN.  A crack starts where D first reaches 1; the crossing within an
+interval is the root of that quadratic.  Wear that removes the surface layer and relieves the edge shows as a
+falling rate: the damage counted is the contact's as it was at each state, not the unworn one's.  How many
+states keep the answer within model.accuracy is measured in scripts/study_fatigue.py.
+"""
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from typing import Optional
+
+import numpy as np
+
+from fretsim.fatigue import history
+from fretsim.fatigue.swt import Basquin, swt_search
+
+STATES_PER_DECADE = 3  # fatigue states on the way up (geometric): the damage rate changes fastest early
+LINEAR_STATES = 8  # ... and evenly over the run, where the contact evolves slowly
+
+
+@dataclass(frozen=True)
+class FatigueSpec:
+    """What the loop needs for fatigue: the flat's curve and elastic constants, the depths, the states."""
+
+    curve: Basquin
+    poisson: float
+    depths: np.ndarray  # mm, the layers below the surface (history.depths)
+    critical_distance: Optional[float]  # mm (line method); None: each point's own SWT
+    states: tuple  # cycles at which the fatigue is evaluated (and the loop details the cycle)
+    crack_limit: bool = False  # stop where the damage reaches 1
+    keep_stresses: bool = False  # output.stresses
+
+
+def fatigue_states(last: int, snapshots: tuple) -> tuple:
+    """0, the recorded states, STATES_PER_DECADE per decade up to ``last`` and LINEAR_STATES evenly over it."""
+    out = {0, int(last)} | {int(s) for s in snapshots if s <= last}
+    if last > 0:
+        k = 0
+        while True:
+            n = int(round(last * 10.0 ** (-k / STATES_PER_DECADE)))
+            if n < 1:
+                break
+            out.add(n)
+            k += 1
+        out |= {int(round(last * j / LINEAR_STATES)) for j in range(1, LINEAR_STATES)}
+    return tuple(sorted(out))
+
+
+@dataclass
+class FatigueState:
+    """The flat's fatigue at one state: fields on (depth, x) over the whole grid (0 where not computed: beyond
+    :func:`history.window` of the contact) and the figures the summary reports."""
+
+    swt: np.ndarray  # MPa, on the critical plane
+    angle: np.ndarray  # rad, the critical plane's normal from x
+    life: np.ndarray  # cycles to initiation if the contact stayed as now (per damage point)
+    max_shear: float  # MPa, the largest in-plane principal shear over the cycle and the field
+    max_shear_depth: float  # mm
+    max_tension: float  # MPa, the largest surface σx over the cycle
+    swt_max: float
+    swt_x: float  # mm
+    swt_depth: float  # mm
+    ruiz_max: float  # MPa²·mm
+    stresses: Optional[tuple] = None  # (σx, σz, τxz) amplitude fields (depth, x): the largest |value| over the cycle
+
+
+def evaluate(spec: FatigueSpec, x: np.ndarray, dx: float, youngs: float, cyc) -> FatigueState:
+    """The flat's fatigue at a state from its cycle's tractions (``cyc.tractions``: pressure, shear, travel, each
+    (states, 1, nx))."""
+    p, q, travel = (np.asarray(a)[:, 0, :] for a in cyc.tractions)
+    keep = _thinned(len(p), slides(p, travel, dx))
+    p, q, travel = p[keep], q[keep], travel[keep]
+    p_flat, q_flat = history.on_flat(p, travel, x, dx), history.on_flat(q, travel, x, dx)
+    cols = history.window(p_flat)
+    z = spec.depths
+    nz, nx = len(z), len(x)
+    full = lambda fill=0.0: np.full((nz, nx), fill)  # noqa: E731
+    swt, angle = full(), full()
+    if cols.stop <= cols.start:
+        return _state(spec, z, x, swt, angle, None, 0.0, 0.0, 0.0, 0.0)
+    st = history.stresses(p_flat[:, cols], q_flat[:, cols], dx, z)
+    plane = swt_search((st.sxx, st.szz, st.sxz), youngs, spec.poisson, slides(p, travel, dx))
+    swt[:, cols], angle[:, cols] = plane.swt, plane.angle
+    shear = np.hypot(0.5 * (st.sxx - st.szz), st.sxz).max(axis=0)  # (depth, x) over the cycle
+    k = np.unravel_index(np.argmax(shear), shear.shape)
+    tension = float(st.sxx[:, 0, :].max())
+    slip_amplitude = 0.25 * np.asarray(cyc.slip_stationary)[0, cols]  # mm: a quarter of the cycle's slip
+    ruiz = np.maximum(st.sxx[:, 0, :].max(axis=0), 0.0) * np.abs(q_flat[:, cols]).max(axis=0) * slip_amplitude
+    amplitudes = None
+    if spec.keep_stresses:
+        amplitudes = tuple(_widen(np.take_along_axis(a, np.abs(a).argmax(axis=0)[None], 0)[0], cols, nx)
+                           for a in (st.sxx, st.szz, st.sxz))
+    return _state(spec, z, x, swt, angle, amplitudes, float(shear[k]), float(z[k[0]]), tension,
+                  float(ruiz.max(initial=0.0)))
+
+
+SLIDE_SPREAD = 0.1  # of an element: an increment whose points all travelled alike within this slid rigidly
+
+
+def slides(pressure: np.ndarray, travel: np.ndarray, dx: float) -> dict:
+    """{state k: elements} for the states the contact reached by sliding as a whole from the state before (every
+    loaded point's travel the same within SLIDE_SPREAD of an element), by at least one element: gross slip's
+    sliding between the elastic sides, which a detailed cycle takes in one increment (the tractions fixed, the
+    mid-stroke models) or a few (the resolved stroke: its tractions within an increment are taken as its end's).
+    The flat saw the tractions at every position on the way (:func:`fretsim.fatigue.swt.swt_search`)."""
+    out = {}
+    for k in range(1, len(travel)):
+        on = pressure[k] > 0
+        if not on.any():
+            continue
+        moved = (travel[k] - travel[k - 1])[on]
+        m = int(round(float(moved.mean()) / dx))
+        if m and float(moved.max() - moved.min()) < SLIDE_SPREAD * dx:
+            out[k] = m
+    return out
+
+
+TIME_STATES = 12  # the cycle's states the stresses are computed at, at most, besides the sliding ones: a recorded
+#                  state's elastic sides are cut in 12 for the loop's shape, the stresses need their ends
+
+
+def _thinned(states: int, slid: dict) -> list:
+    """The states kept: the first and last, every sliding one and the one it slid from, and evenly among the rest
+    up to TIME_STATES."""
+    stride = max(1, int(np.ceil(states / TIME_STATES)))
+    keep = {0, states - 1} | set(slid) | {k - 1 for k in slid} | set(range(0, states, stride))
+    return sorted(keep)
+
+
+def _widen(a: np.ndarray, cols: slice, nx: int) -> np.ndarray:
+    out = np.zeros(a.shape[:-1] + (nx,))
+    out[..., cols] = a
+    return out
+
+
+def _state(spec, z, x, swt, angle, amplitudes, max_shear, shear_depth, tension, ruiz) -> FatigueState:
+    k = np.unravel_index(np.argmax(swt), swt.shape)
+    return FatigueState(swt=swt, angle=angle, life=spec.curve.lives(damage_parameter(spec, swt)),
+                        max_shear=max_shear, max_shear_depth=shear_depth, max_tension=tension,
+                        swt_max=float(swt[k]), swt_x=float(x[k[1]]), swt_depth=float(z[k[0]]), ruiz_max=ruiz,
+                        stresses=amplitudes)
+
+
+def damage_parameter(spec: FatigueSpec, swt: np.ndarray) -> np.ndarray:
+    """The SWT the damage is counted with: each point's (depth, x), or with a critical distance L its mean over
+    the depths 0 to L below each surface point (x) — the line method, trapezoidal over the layers, the surface
+    layer standing for z = 0 and the field interpolated at L."""
+    L = spec.critical_distance
+    if L is None:
+        return swt
+    z = np.concatenate([[0.0], spec.depths[1:]])  # the surface layer is at the surface
+    inside = z < L
+    zs = np.concatenate([z[inside], [L]])
+    at_l = np.array([np.interp(L, z, swt[:, j]) for j in range(swt.shape[1])])
+    values = np.concatenate([swt[inside], at_l[None, :]], axis=0)
+    return np.trapezoid(values, zs, axis=0)[None, :] / L
+
+
+@dataclass
+class Miner:
+    """Miner's sum over the fatigue states so far, per damage point; where and when it first reached 1."""
+
+    damage: Optional[np.ndarray] = None
+    rate: Optional[np.ndarray] = None  # 1/N_i at the last state
+    cycle: float = 0.0  # of the last state
+    crack: Optional[tuple] = None  # (cycle, damage point index (depth, x)) where D first reached 1
+    peaks: dict = field(default_factory=dict)  # the largest figures over the states (and where)
+
+    def add(self, n: int, state: FatigueState) -> None:
+        rate = np.where(np.isfinite(state.life), 1.0 / np.where(np.isfinite(state.life), state.life, 1.0), 0.0)
+        if self.damage is None:
+            self.damage = np.zeros_like(rate)
+        else:
+            span = float(n) - self.cycle
+            before = self.damage
+            self.damage = before + 0.5 * (self.rate + rate) * span
+            if self.crack is None and (self.damage >= 1.0).any():
+                self.crack = _crossing(before, self.rate, rate, span, self.cycle)
+        self.rate, self.cycle = rate, float(n)
+        for key, value, where in (("max_shear", state.max_shear, state.max_shear_depth),
+                                  ("max_tension", state.max_tension, 0.0), ("ruiz_max", state.ruiz_max, 0.0),
+                                  ("swt_max", state.swt_max, (state.swt_x, state.swt_depth))):
+            if key not in self.peaks or value > self.peaks[key][0]:
+                self.peaks[key] = (value, where)
+
+    def to_state(self) -> dict:
+        """For the loop's checkpoint (flat arrays and numbers)."""
+        if self.damage is None:
+            return {}
+        # (layers, 1, x): the grid's (y, x) last, so that a widening of the grid pads them as it pads the wear
+        out = {"fatigue_damage": self.damage[:, None, :], "fatigue_rate": self.rate[:, None, :],
+               "fatigue_cycle": self.cycle}
+        if self.crack is not None:
+            out["fatigue_crack"] = np.array([self.crack[0], *self.crack[1]], dtype=float)
+        for key, (value, where) in self.peaks.items():
+            out[f"fatigue_peak_{key}"] = np.array([value, *np.atleast_1d(where)], dtype=float)
+        return out
+
+    @classmethod
+    def from_state(cls, st: dict) -> "Miner":
+        if "fatigue_damage" not in st:
+            return cls()
+        crack = None
+        if "fatigue_crack" in st:
+            c = np.asarray(st["fatigue_crack"], dtype=float)
+            crack = (float(c[0]), tuple(int(v) for v in c[1:]))
+        peaks = {}
+        for key in ("max_shear", "max_tension", "ruiz_max", "swt_max"):
+            if f"fatigue_peak_{key}" in st:
+                v = [float(a) for a in np.atleast_1d(st[f"fatigue_peak_{key}"])]
+                peaks[key] = (v[0], tuple(v[1:]) if len(v) > 2 else v[1])
+        return cls(np.asarray(st["fatigue_damage"], dtype=float)[:, 0, :],
+                   np.asarray(st["fatigue_rate"], dtype=float)[:, 0, :], float(st["fatigue_cycle"]), crack, peaks)
+
+
+def _crossing(before: np.ndarray, r0: np.ndarray, r1: np.ndarray, span: float, start: float) -> tuple:
+    """The first cycle at which D(t) = D₀ + r₀t + (r₁ − r₀)t²/(2ΔN) reaches 1 over the points that passed it in
+    this interval, and that point."""
+    passed = np.flatnonzero((before + 0.5 * (r0 + r1) * span >= 1.0).ravel())
+    b, c = r0.ravel()[passed], before.ravel()[passed] - 1.0
+    a = (r1.ravel()[passed] - r0.ravel()[passed]) / (2.0 * span)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        quad = (-b + np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))) / (2.0 * a)
+        t = np.where(np.abs(a) * span < 1e-12 * np.maximum(np.abs(b), 1e-300), -c / b, quad)
+    t = np.clip(np.nan_to_num(t, nan=span), 0.0, span)
+    k = int(np.argmin(t))
+    return start + float(t[k]), tuple(int(i) for i in np.unravel_index(passed[k], before.shape))
+
+
+def damage_mode(crack_cycle: float, wear_limit_cycle: float) -> str:
+    """"cracking" where the crack starts before any wear limit is reached, "wear" where a wear limit comes first,
+    "none" where neither happens within the run."""
+    crack, wear = math.isfinite(crack_cycle), math.isfinite(wear_limit_cycle)
+    if crack and (not wear or crack_cycle <= wear_limit_cycle):
+        return "cracking"
+    return "wear" if wear else "none"
+
+
+def summary(spec: FatigueSpec, state: dict, x: np.ndarray, limit: Optional[tuple]) -> dict:
+    """The summary's fatigue figures from a step's checkpoint (``Step.state``) and the limit it stopped at."""
+    miner = Miner.from_state(state)
+    nan = float("nan")
+    peak = lambda key: miner.peaks.get(key, (nan, nan))  # noqa: E731
+    swt, (swt_x, swt_z) = peak("swt_max")[0], (peak("swt_max")[1] if "swt_max" in miner.peaks else (nan, nan))
+    crack = miner.crack[0] if miner.crack is not None else nan
+    wear_limit = limit[1] if limit is not None and limit[0] != "crack_initiation" else nan
+    return {
+        "max_shear_stress_MPa": peak("max_shear")[0],
+        "max_shear_stress_depth_um": peak("max_shear")[1] * 1e3,
+        "max_surface_tensile_stress_MPa": peak("max_tension")[0],
+        "swt_max_MPa": swt,
+        "swt_location_x_mm": swt_x,
+        "swt_depth_um": swt_z * 1e3,
+        "ruiz_max": peak("ruiz_max")[0],
+        "cycles_to_crack_initiation": crack,
+        "crack_location_x_mm": float(x[miner.crack[1][-1]]) if miner.crack is not None else nan,
+        "fatigue_damage": float(miner.damage.max()) if miner.damage is not None else nan,
+        "damage_mode": damage_mode(crack, wear_limit),
+    }

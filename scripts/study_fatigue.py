@@ -1,0 +1,78 @@
+"""Fretting fatigue over the wear history: how many fatigue states the damage needs, and what fatigue costs.
+
+For the Ti-6Al-4V-like cylinder-on-flat case (cases/ti_fretting_fatigue.yaml) at strokes in partial slip, near
+the transition and in gross slip, the crack-initiation cycle (and the damage at the end where none starts) with
+the fatigue states at the default density and at denser and sparser ones (STATES_PER_DECADE, LINEAR_STATES of
+fretsim.fatigue.damage), against the densest; and the run's time with fatigue against the same run without.
+
+    python scripts/study_fatigue.py            # → scripts/results/fatigue_states.txt
+"""
+from __future__ import annotations
+
+import math
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+from fretsim.case import load_case
+from fretsim.fatigue import damage
+from fretsim.runner import run
+
+ROOT = Path(__file__).resolve().parent.parent
+CASE = ROOT / "cases" / "ti_fretting_fatigue.yaml"
+STROKES = ("2 um", "5 um", "10 um")
+DENSITIES = ((1, 4), (2, 4), (3, 8), (6, 16), (12, 32))  # (per decade, linear); the last is the reference
+
+
+DEFAULT = (damage.STATES_PER_DECADE, damage.LINEAR_STATES)
+
+
+def _crack(stroke: str, per_decade: int, linear: int, extra=()) -> tuple:
+    damage.STATES_PER_DECADE, damage.LINEAR_STATES = per_decade, linear
+    case = load_case(str(CASE), [f"loading.stroke={stroke}", "grid.error_estimate=none", *extra])
+    with tempfile.TemporaryDirectory() as tmp:
+        t = time.perf_counter()
+        out = run(case, Path(tmp) / "r.h5")
+        seconds = time.perf_counter() - t
+    st = out.last.state
+    crack = float(st["fatigue_crack"][0]) if "fatigue_crack" in st else math.nan
+    return crack, float(st["fatigue_damage"].max()), seconds, out.summary["contact_solves"]
+
+
+def main() -> None:
+    lines = [__doc__.split("\n\n")[0], "", f"case {CASE.name}; grid.error_estimate none", "",
+             "stroke   states/decade linear   crack cycle   damage at end   vs densest   run s   solves"]
+    for stroke in STROKES:
+        rows = [(d, _crack(stroke, *d)) for d in DENSITIES]
+        ref_crack, ref_damage = rows[-1][1][:2]
+        for (per_decade, linear), (crack, dmg, sec, solves) in rows:
+            if math.isfinite(ref_crack):
+                diff = f"{crack / ref_crack - 1:+.2%}" if math.isfinite(crack) else "no crack"
+            else:
+                diff = f"{dmg / ref_damage - 1:+.2%} (damage)"
+            lines.append(f"{stroke:8s} {per_decade:13d} {linear:6d}   {crack:11.6g}   {dmg:13.4g}   {diff:>10s}   "
+                         f"{sec:5.2f}   {solves:6d}")
+        damage.STATES_PER_DECADE, damage.LINEAR_STATES = DEFAULT
+    lines += ["", "cost: the default run with fatigue against the same without (materials.stationary.fatigue null), "
+                  "median of 3, in turn"]
+    for stroke in STROKES:
+        with_f, without = [], []
+        for _ in range(3):
+            with_f.append(_crack(stroke, *DEFAULT)[2])
+            case = load_case(str(CASE), [f"loading.stroke={stroke}", "grid.error_estimate=none",
+                                         "materials.stationary.fatigue=null"])
+            with tempfile.TemporaryDirectory() as tmp:
+                t = time.perf_counter()
+                run(case, Path(tmp) / "r.h5")
+                without.append(time.perf_counter() - t)
+        a, b = sorted(with_f)[1], sorted(without)[1]
+        lines.append(f"  {stroke:6s}: with {a:.2f} s, without {b:.2f} s, ratio {a / b:.2f}")
+    text = "\n".join(lines) + "\n"
+    print(text)
+    if "--no-write" not in sys.argv:
+        (ROOT / "scripts" / "results" / "fatigue_states.txt").write_text(text)
+
+
+if __name__ == "__main__":
+    main()
