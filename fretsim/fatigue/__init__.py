@@ -4,6 +4,7 @@
   (closed forms of the strips' line-load integrals);
 * :mod:`.swt` — the Smith–Watson–Topper parameter on the critical plane, its life from the Basquin–Coffin–Manson
   curve, and Ruiz's fretting damage parameter.
+* :mod:`.stresses3d` — the same for the 3D half-space on a grid (rectangles by FFT); :func:`.swt.swt_3d` in 3D.
 
 Pure functions over arrays; nothing here is wired into the loop yet.
 """

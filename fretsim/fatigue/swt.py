@@ -220,3 +220,64 @@ def ruiz(tensile: np.ndarray, shear: np.ndarray, slip: np.ndarray) -> np.ndarray
     """Ruiz's fretting damage parameter σ_t·τ·δ at each surface point (MPa²·mm): the largest tensile surface
     stress over the cycle (compression counts 0), the shear traction's amplitude and the slip amplitude."""
     return np.maximum(tensile, 0.0) * np.abs(shear) * np.abs(slip)
+
+
+NORMALS = 400  # plane normals searched in 3D: a Fibonacci hemisphere, ~6° apart (the parameter is even in n)
+
+
+def hemisphere_normals(count: int = NORMALS) -> np.ndarray:
+    """``count`` unit normals (count, 3) spread near-uniformly over the hemisphere n_z ≥ 0 (a Fibonacci lattice:
+    equal-area bands in n_z, the golden angle in azimuth) — deterministic, so a run's critical planes repeat."""
+    i = np.arange(count) + 0.5
+    nz = i / count
+    azimuth = i * (np.pi * (3.0 - math.sqrt(5.0)))
+    s = np.sqrt(1.0 - nz * nz)
+    return np.stack([s * np.cos(azimuth), s * np.sin(azimuth), nz], axis=1)
+
+
+@dataclass(frozen=True)
+class CriticalPlane3D:
+    """The SWT parameter at each point on its critical plane: value (MPa) and the plane's unit normal (..., 3)
+    in (x, y, z)."""
+
+    swt: np.ndarray
+    normal: np.ndarray
+
+
+def _components(history) -> np.ndarray:
+    """The history as one array (6, time, ...): from six arrays (σxx, σyy, σzz, σxy, σxz, σyz) or anything with
+    those as attributes (a :class:`~fretsim.fatigue.stresses3d.Stress3D` with time first)."""
+    names = ("sxx", "syy", "szz", "sxy", "sxz", "syz")
+    parts = [getattr(history, n) for n in names] if hasattr(history, "sxx") else list(history)
+    if len(parts) != 6:
+        raise ValueError(f"a 3D stress history has six components, got {len(parts)}")
+    return np.stack(np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in parts)))
+
+
+def swt_3d(history, youngs: float, poisson: float, normals: Optional[np.ndarray] = None,
+           chunk: int = 4_000_000) -> CriticalPlane3D:
+    """SWT = σ_n,max·Δε_n/2 on the critical plane at each point, the largest over ``normals`` (k, 3) (default:
+    :func:`hemisphere_normals`), from the stresses over a cycle: ``history`` = (σxx, σyy, σzz, σxy, σxz, σyz),
+    each (time, ...), or a Stress3D with time first.  Isotropic linear elasticity: ε_n = ((1 + ν)σ_n − ν·tr σ)/E.
+    ``chunk`` bounds the work array (time × points × normals) so that a grid's whole volume fits in memory."""
+    s = _components(history)
+    n = hemisphere_normals() if normals is None else np.asarray(normals, dtype=float)
+    n = n / np.linalg.norm(n, axis=1, keepdims=True)
+    # σ_n = nᵀσn as one product: the six components against (nx², ny², nz², 2nxny, 2nxnz, 2nynz)
+    weights = np.stack([n[:, 0] ** 2, n[:, 1] ** 2, n[:, 2] ** 2, 2 * n[:, 0] * n[:, 1], 2 * n[:, 0] * n[:, 2],
+                        2 * n[:, 1] * n[:, 2]])
+    steps, shape = s.shape[1], s.shape[2:]
+    flat = s.reshape(6, steps, -1)
+    points = flat.shape[2]
+    best = np.empty(points)
+    where = np.empty(points, dtype=int)
+    size = max(1, chunk // max(1, steps * len(n)))
+    for lo in range(0, points, size):
+        part = flat[:, :, lo:lo + size]
+        sn = np.einsum("ctp,ck->tpk", part, weights)
+        trace = (part[0] + part[1] + part[2])[:, :, None]
+        en = ((1.0 + poisson) * sn - poisson * trace) / youngs
+        value = np.maximum(sn.max(axis=0), 0.0) * 0.5 * (en.max(axis=0) - en.min(axis=0))
+        where[lo:lo + size] = np.argmax(value, axis=1)
+        best[lo:lo + size] = value[np.arange(value.shape[0]), where[lo:lo + size]]
+    return CriticalPlane3D(best.reshape(shape), n[where].reshape(shape + (3,)))
