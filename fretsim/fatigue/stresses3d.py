@@ -40,12 +40,18 @@ against a quadrature of those point loads, the FFT against a direct sum, Hertz (
 sphere against a quadrature of Cerruti over Hamilton's traction.  Y + ρ and ρ − z are evaluated in forms free of
 cancellation: (ρ − Y)/(X² + z²) for 1/(Y + ρ) when Y < 0, (X² + Y²)/(ρ + z) for ρ − z.
 
-Cost (s per depth layer: kernels, their FFTs and the six inverse FFTs; pressure and q_x loaded, q_y zero; one
-core, numpy 2.4 / scipy 1.17; ``python scripts/bench_stresses3d.py``; scripts/results/stresses3d_cost.txt)::
+Cost, seconds per depth layer (the kernels, their FFTs, the products and the six inverse FFTs; the tractions'
+FFTs are paid once per call), one thread, numpy 2.4 / scipy 1.17 on a shared 2-core machine, minimum of 9
+(``python scripts/bench_stresses3d.py``, which writes scripts/results/stresses3d_cost.txt)::
 
-    grid (nx × ny)   padded FFT     s/layer
-    427 × 27         854 × 54       see scripts/results/stresses3d_cost.txt
-    128 × 128        256 × 256
+    grid nx × ny   padded FFT   loaded        s/layer
+    427 × 27       864 × 54     p, q_x        0.025
+    427 × 27       864 × 54     p, q_x, q_y   0.032
+    128 × 128      256 × 256    p, q_x        0.032
+    128 × 128      256 × 256    p, q_x, q_y   0.061
+
+so 40 depths on the 427 × 27 grid cost about a second per stress state; the kernels (transcendental functions on
+the 2n × 2n edges) are about half of it.
 
 All lengths in mm, tractions and stresses in MPa; the grid's arrays are shaped (ny, nx) as in
 :mod:`fretsim.compliance`.
@@ -199,10 +205,12 @@ def half_space_stresses(x: np.ndarray, y: np.ndarray, dx: float, dy: float, pres
     out = np.zeros((6, depths.size, ny, nx))
     if not any(loads):
         return Stress3D(*out)
+    on = [m for m in range(3) if loads[m]]
     for d, z in enumerate(depths):
-        kernel_hat = _wrapped_transform(influence_kernels(nx, ny, dx, dy, z, poisson, loads), shape)
+        kernel_hat = _wrapped_transform(influence_kernels(nx, ny, dx, dy, z, poisson, loads)[on], shape)
         for k in range(6):
-            total = sum(kernel_hat[m, k] * hats[m] for m in range(3) if loads[m])
+            # the loads add in Fourier space: one inverse transform per component
+            total = sum(kernel_hat[i, k] * hats[m] for i, m in enumerate(on))
             out[k, d] = sfft.irfft2(total, s=shape)[:ny, :nx]
     return Stress3D(*out)
 
