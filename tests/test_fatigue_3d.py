@@ -4,11 +4,12 @@ forms and quadratures derived independently of the rectangles' corner functions,
 
 The independent references are the point-force solutions written out here in Cartesian form — Boussinesq's normal
 force (from Johnson, Contact Mechanics eq. 3.21's σr, σθ) and Cerruti's tangential force (Johnson eq. 3.87) —
-integrated numerically over a rectangle or over the Hertzian tractions, and Hertz's closed forms on the axis
-(Johnson §3.4).  Hamilton's 1983 closed forms for the sliding sphere were not available to this work; the
-sliding sphere is checked instead against quadratures of Boussinesq and Cerruti over Hamilton's tractions
-(p = p₀√(1 − r²/a²), q_x = μp), which is what Hamilton's expressions evaluate, and at the trailing edge against
-the closed value p₀[(1 − 2ν)/3 + (4 + ν)πμ/8] derived in that test's docstring."""
+integrated numerically over a rectangle or over the Hertzian tractions, and Hertz's closed forms (Johnson §3.4).
+Hamilton's 1983 paper itself was not available to this work: the sliding sphere (his tractions p = p₀√(1 − r²/a²),
+q_x = μp) is checked against quadratures of Boussinesq and Cerruti over them — below the surface, and on the
+surface along the sliding axis, where the quadrature also confirms the closed forms Hamilton and Johnson §7.1
+quote (the friction's −(4 + ν)πμp₀x/8a inside the contact, p₀[(1 − 2ν)/3 + (4 + ν)πμ/8] at the trailing edge,
+the latter derived in its test's docstring)."""
 import math
 
 import numpy as np
@@ -180,6 +181,55 @@ def test_the_sliding_spheres_trailing_edge_tension_is_p0_times_1_minus_2nu_over_
     gaps = [want - v for v in values]
     assert 0 < gaps[1] < 0.1 * want and gaps[0] / gaps[1] == pytest.approx(2.0, rel=0.05)
     assert values[1] + (values[1] - values[0]) == pytest.approx(want, rel=0.01)
+
+
+def _surface_sxx_reference(x0, mu):
+    """σx at the surface point (x0, 0) under Hamilton's tractions, by quadrature: in polar coordinates (s, θ) about
+    the point the point forces' surface σx are k(θ)/s² (normal: (1 − 2ν)cos2θ/2π; tangential:
+    cosθ((1 + ν)cos²θ + (1 − 2ν)sin²θ)/π), both of zero mean over θ, so the integral is a principal value in which
+    the point's own traction t₀ drops out: ∫k(θ)[∫₀ᴸ (t − t₀)/s ds + t₀·ln L]dθ, plus the pressure's local part
+    −(1 + 2ν)t₀/2 (Love's uniform disc at its centre).  Outside the contact the ray's chord is a plain integral."""
+    t0 = P0 * math.sqrt(max(0.0, 1 - (x0 / A) ** 2))
+
+    def radial(theta):
+        pu = x0 * math.cos(theta)
+        disc = pu * pu - x0 * x0 + A * A  # the ray meets the circle at s = −pu ± √disc
+        if disc <= 0 or -pu + math.sqrt(disc) <= 0:
+            return 0.0
+        hi, lo = -pu + math.sqrt(disc), -pu - math.sqrt(disc)
+        t = lambda s: P0 * math.sqrt(max(0.0, (hi - s) * (s - lo))) / A  # noqa: E731
+        if lo < 0:
+            return integrate.quad(lambda s: (t(s) - t0) / s, 0, hi, epsabs=1e-13, limit=200)[0] + t0 * math.log(hi)
+        return integrate.quad(lambda s: t(s) / s, lo, hi, epsabs=1e-13, limit=200)[0]
+
+    def kernel(theta):
+        c, s = math.cos(theta), math.sin(theta)
+        normal = (1 - 2 * NU) * math.cos(2 * theta) / (2 * math.pi)
+        return normal + mu * c * ((1 + NU) * c * c + (1 - 2 * NU) * s * s) / math.pi
+
+    return -(1 + 2 * NU) / 2 * t0 + integrate.quad(lambda th: kernel(th) * radial(th), 0, 2 * math.pi, epsabs=1e-12,
+                                                   limit=400, points=[math.pi / 2, math.pi, 3 * math.pi / 2])[0]
+
+
+def test_the_sliding_spheres_surface_stress_along_the_sliding_axis():
+    """The surface σx on the x axis under full sliding (μ = 0.3), in and around the contact.  Inside it the
+    quadrature equals Hamilton's closed form — the frictionless part p₀[(1 − 2ν)(1 − (1 − r²)^{3/2})/(3r²) −
+    √(1 − r²)] (Johnson eq. 3.41a) plus the friction's −(4 + ν)πμp₀x/(8a), linear in x — to 1e-8 p₀.  The grid (80
+    elements per radius) follows the quadrature within 3e-3 p₀: a first-order error of the midpoint-sampled tractions
+    (2.1e-3 p₀ at x = −0.8 a, halving with the elements)."""
+    mu = 0.3
+    xs = np.array([-1.5, -1.2, -0.8, -0.5, 0.0, 0.3, 0.7, 1.2, 1.5]) * A
+    ref = np.array([_surface_sxx_reference(v, mu) for v in xs])
+    t = np.abs(xs[2:7]) / A
+    with np.errstate(divide="ignore", invalid="ignore"):
+        radial = np.where(t > 0, (1 - 2 * NU) * (1 - (1 - t * t) ** 1.5) / (3 * t * t), 0.0)
+    frictionless = P0 * (radial - np.sqrt(1 - t * t))
+    frictionless[t == 0] = -(1 + 2 * NU) / 2 * P0
+    np.testing.assert_allclose(ref[2:7], frictionless - (4 + NU) * math.pi * mu * P0 * xs[2:7] / (8 * A), atol=1e-8)
+    x, dx, p = _hertz(80, extent=1.5)
+    s = half_space_stresses(x, x, dx, dx, p, mu * p, None, np.array([1e-6 * A]), NU)
+    idx = [int(np.argmin(np.abs(x - v))) for v in xs]
+    np.testing.assert_allclose(s.sxx[0, x.size // 2, idx], ref, rtol=0, atol=3e-3 * P0)
 
 
 def _sliding_reference(x, y, z, mu):
