@@ -3,11 +3,11 @@ forms and quadratures derived independently of the rectangles' corner functions,
 3D normals against the 2D search and the uniaxial formula.
 
 The independent references are the point-force solutions written out here in Cartesian form — Boussinesq's normal
-force (from Johnson, Contact Mechanics eq. 3.21's σr, σθ) and Cerruti's tangential force (Johnson eq. 3.87) —
+force (from its σr, σθ, σz, τrz in Johnson, Contact Mechanics ch. 3) and Cerruti's tangential force (ibid.) —
 integrated numerically over a rectangle or over the Hertzian tractions, and Hertz's closed forms (Johnson §3.4).
 Hamilton's 1983 paper itself was not available to this work: the sliding sphere (his tractions p = p₀√(1 − r²/a²),
 q_x = μp) is checked against quadratures of Boussinesq and Cerruti over them — below the surface, and on the
-surface along the sliding axis, where the quadrature also confirms the closed forms Hamilton and Johnson §7.1
+surface along the sliding axis, where the quadrature also confirms the closed forms Hamilton and Johnson (ch. 7)
 quote (the friction's −(4 + ν)πμp₀x/8a inside the contact, p₀[(1 − 2ν)/3 + (4 + ν)πμ/8] at the trailing edge,
 the latter derived in its test's docstring)."""
 import math
@@ -26,7 +26,7 @@ A, P0 = 1.0, 1.0  # the Hertz radius and peak pressure: the results scale with t
 
 def _boussinesq(x, y, z, nu):
     """(σxx, σyy, σzz, σxy, σxz, σyz) at (x, y, z) from a unit normal force pressing into the surface at the
-    origin: Johnson eq. 3.21's σr, σθ, σz, τrz turned to Cartesian axes (σxy = (σr − σθ)·xy/r²)."""
+    origin: Boussinesq's σr, σθ, σz, τrz (Johnson ch. 3) turned to Cartesian axes (σxy = (σr − σθ)·xy/r²)."""
     r2 = x * x + y * y
     rho = np.sqrt(r2 + z * z)
     c, k = 1 - 2 * nu, 1 / (2 * np.pi)
@@ -42,7 +42,7 @@ def _boussinesq(x, y, z, nu):
 
 
 def _cerruti(x, y, z, nu):
-    """The same for a unit tangential force along +x at the origin (Johnson eq. 3.87)."""
+    """The same for a unit tangential force along +x at the origin (Cerruti's; Johnson ch. 3)."""
     rho = np.sqrt(x * x + y * y + z * z)
     c, k, t = 1 - 2 * nu, 1 / (2 * np.pi), rho + z
     return np.array([
@@ -108,7 +108,7 @@ def _hertz(m: int, extent: float = 1.0):
 
 
 def _hertz_axis(z, nu):
-    """Johnson §3.4 (eq. 3.45): σz and σr = σθ on the axis below a frictionless sphere."""
+    """Johnson §3.4: σz and σr = σθ on the axis below a frictionless sphere."""
     t = z / A
     return -P0 / (1 + t * t), -P0 * ((1 + nu) * (1 - t * np.arctan(1 / t)) - 0.5 / (1 + t * t))
 
@@ -136,7 +136,7 @@ def test_hertz_sphere_on_the_axis_and_its_largest_shear_0_31_p0_at_0_48_a():
 
 
 def test_hertz_sphere_pulls_the_surface_at_its_edge_to_one_third_of_1_minus_2nu_p0():
-    """Johnson eq. 3.44: σr = (1 − 2ν)p₀/3 at r = a (the surface's largest tension).  The edge is where the
+    """Johnson §3.4: σr = (1 − 2ν)p₀/3 at r = a (the surface's largest tension).  The edge is where the
     pressure's √ is worst resolved: the gap is first order in the element size — it halves when the elements
     halve — and under 1 % of the value at 80 elements per radius."""
     want = (1 - 2 * NU) / 3 * P0
@@ -151,7 +151,7 @@ def test_hertz_sphere_pulls_the_surface_at_its_edge_to_one_third_of_1_minus_2nu_
 
 
 def test_the_sliding_spheres_trailing_edge_tension_is_p0_times_1_minus_2nu_over_3_plus_4_plus_nu_pi_mu_over_8():
-    """Hamilton (1983) and Johnson §7.1: sliding along +x (q_x = μp), the surface's largest tension is at the
+    """Hamilton (1983), quoted in Johnson ch. 7: sliding along +x (q_x = μp), the surface's largest tension is at the
     trailing edge (−a, 0): σx = p₀[(1 − 2ν)/3 + (4 + ν)πμ/8].  Derivation: at the surface a point force's σx is
     (1 − 2ν)(X² − Y²)/(2πs⁴) (normal) and −X((1 + ν)X² + (1 − 2ν)Y²)/(πs⁵) (tangential), s the distance from the
     force.  In polar coordinates (s, θ) about the edge point the disc is 0 ≤ s ≤ 2a·cosθ, where
@@ -214,7 +214,7 @@ def _surface_sxx_reference(x0, mu):
 def test_the_sliding_spheres_surface_stress_along_the_sliding_axis():
     """The surface σx on the x axis under full sliding (μ = 0.3), in and around the contact.  Inside it the
     quadrature equals Hamilton's closed form — the frictionless part p₀[(1 − 2ν)(1 − (1 − r²)^{3/2})/(3r²) −
-    √(1 − r²)] (Johnson eq. 3.41a) plus the friction's −(4 + ν)πμp₀x/(8a), linear in x — to 1e-8 p₀.  The grid (80
+    √(1 − r²)] (Johnson §3.4) plus the friction's −(4 + ν)πμp₀x/(8a), linear in x — to 1e-8 p₀.  The grid (80
     elements per radius) follows the quadrature within 3e-3 p₀: a first-order error of the midpoint-sampled tractions
     (2.1e-3 p₀ at x = −0.8 a, halving with the elements)."""
     mu = 0.3

@@ -11,9 +11,10 @@ Each element (a rectangle |ξ − x_k| ≤ dx/2, |η − y_l| ≤ dy/2) carries 
 and uniform shear tractions q_x, q_y acting on this body.  z > 0 points into the body and tension is positive,
 so at the surface σzz = −p, σxz = −q_x, σyz = −q_y.
 
-The closed forms (derived here; Love 1929 gives the pressure part, Liu & Wang 2002 and Johnson's Contact
-Mechanics §3.2 the same potentials).  With Ω = z·ln(ρ + z) − ρ, ρ² = X² + Y² + z², the point-load fields are
-derivatives of Ω (Johnson eqs. 3.10–3.12 with H₁ or F₁ = Ω).  A rectangle's field is Σ_corners s·F(X, Y, z)
+The closed forms are derived here, from the Boussinesq–Cerruti potentials of Johnson's Contact Mechanics §3.2
+(Love 1929 gave the pressure's rectangle; Liu & Wang 2002 tabulate both — neither was consulted for the code).
+With Ω = z·ln(ρ + z) − ρ, ρ² = X² + Y² + z², the point-load fields are derivatives of Ω (the potentials with
+H₁ = Ω for the pressure, F₁ = Ω for q_x).  A rectangle's field is Σ_corners s·F(X, Y, z)
 where ∂X∂Y F is the point kernel, X = x − ξ_c, Y = y − η_c, and s = +1 at (x + a, y + b) and (x − a, y − b),
 −1 at the other two corners.  Where a kernel has no ∂X (or ∂Y) to absorb the primitive, ∇²Ω = 0 trades ∂X² for
 −∂Y² − ∂z²; functions of X alone or Y alone drop out of the corner sum.  The corner functions are
@@ -33,12 +34,13 @@ and for the shear q_x (q_y: the same with x and y exchanged)
     σyy: 2νL_Y − 2νY/(ρ + z) − zY/(ρ(ρ + z))                     σxz: K − zX/(ρ(Y + ρ))
     σzz: −z²/(ρ(Y + ρ))                                           σyz: −z/ρ
 
-They were derived with sympy (displacements from the potentials, Hooke's law, then the primitives); the
-point-load fields satisfy equilibrium, free surface away from the load and the resultant, and agree with
-Boussinesq's and Cerruti's stresses (Johnson eqs. 3.22, 3.87).  tests/test_fatigue_3d.py checks the rectangle
-against a quadrature of those point loads, the FFT against a direct sum, Hertz (Johnson §3.4) and a sliding
-sphere against a quadrature of Cerruti over Hamilton's traction.  Y + ρ and ρ − z are evaluated in forms free of
-cancellation: (ρ − Y)/(X² + z²) for 1/(Y + ρ) when Y < 0, (X² + Y²)/(ρ + z) for ρ − z.
+They were derived with sympy (displacements from the potentials, Hooke's law, then the primitives:
+``python scripts/derive_stresses3d.py`` redoes it); the point-load fields satisfy equilibrium, a free surface
+away from the load and the force's resultant, and equal Boussinesq's and Cerruti's stresses (Johnson ch. 3).
+tests/test_fatigue_3d.py checks the rectangle against a quadrature of those point loads, the FFT against a
+direct sum, Hertz (Johnson §3.4) and the sliding sphere against quadratures over Hamilton's tractions.
+Y + ρ and ρ − z are evaluated in forms free of cancellation: (ρ − Y)/(X² + z²) for 1/(Y + ρ) when Y < 0,
+(X² + Y²)/(ρ + z) for ρ − z.
 
 Cost, seconds per depth layer (the kernels, their FFTs, the products and the six inverse FFTs; the tractions'
 FFTs are paid once per call), one thread, numpy 2.4 / scipy 1.17 on a shared 2-core machine, minimum of 9
