@@ -64,10 +64,11 @@ def _cerruti_y(x, y, z, nu):
 
 
 @pytest.mark.parametrize("x, y, z", [(0.2, 0.1, 0.3), (1.3, -0.7, 0.4), (-0.45, 0.25, 0.05), (0.013, 0.0071, 1.0),
-                                     (-2.0, 3.0, 0.2)])
+                                     (-2.0, 3.0, 0.2), (0.5, -0.3, 0.2)])
 def test_one_rectangle_equals_a_quadrature_of_boussinesq_and_cerruti(x, y, z):
     """The rectangle |ξ| ≤ 0.5, |η| ≤ 0.3 under unit p, q_x and q_y: the corner functions against scipy's adaptive
-    quadrature of the point forces over it (smooth for z > 0; to 1e-10, the quadrature's own tolerance)."""
+    quadrature of the point forces over it (smooth for z > 0; to 1e-10, the quadrature's own tolerance) — also
+    straight below a corner, where two corner functions take their limits."""
     a, b = 0.5, 0.3
     closed = rectangle_stresses(np.array(x), np.array(y), z, a, b, NU)
     for load, kernel in enumerate((_boussinesq, _cerruti, _cerruti_y)):

@@ -112,10 +112,11 @@ def _corner_functions(X: np.ndarray, Y: np.ndarray, z: float, nu: float) -> np.n
         inv_x = np.where(X >= 0, 1.0 / (X + rho), (rho - X) / (y2 + z2))
         log_y = np.where(Y >= 0, np.log(Y + rho), np.log(x2 + z2) - np.log(rho - Y))
         log_x = np.where(X >= 0, np.log(X + rho), np.log(y2 + z2) - np.log(rho - X))
-    k = -np.arctan(X * Y / (z * rho))
-    b_y = np.arctan(X * Y * rmz / (x2 * rho + y2 * z))
-    b_x = np.arctan(X * Y * rmz / (y2 * rho + x2 * z))
-    lx10, ly10 = Y * inv_x / rho, X * inv_y / rho  # ∂X ln(X + ρ)-type terms: Y/(ρ(X + ρ)), X/(ρ(Y + ρ))
+    k = -np.arctan2(X * Y, z * rho)
+    # arctan2 with a denominator ≥ 0 is atan of the ratio, and 0 (the limit) on a corner's own vertical
+    b_y = np.arctan2(X * Y * rmz, x2 * rho + y2 * z)
+    b_x = np.arctan2(X * Y * rmz, y2 * rho + x2 * z)
+    lx10, ly10 = Y * inv_x / rho, X * inv_y / rho
     lx01, ly01 = z * inv_x / rho, z * inv_y / rho
     c = 1.0 - 2.0 * nu
     pressure = (2 * nu * k - c * b_y - z * ly10, 2 * nu * k - c * b_x - z * lx10, k + z * (ly10 + lx10),
