@@ -546,6 +546,12 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
     click.echo(f"explicit stability limit: {setup.stability_limit:.4g} cycles (solve grid, gap model {filled.gap_model})")
     if loading.friction_coefficient is not None:
         click.echo(_check_regime(setup, loading))
+    if setup.fatigue is not None:
+        f = setup.fatigue
+        line = "line method over " + f"{f.critical_distance * 1e3:.3g} µm" if f.critical_distance else "point values"
+        click.echo(f"fretting fatigue: the flat's SWT on the critical plane ({line}) at {len(f.states)} fatigue "
+                   f"states, {len(f.depths)} depths to {f.depths[-1] * 1e3:.3g} µm; Miner's sum over the wear history"
+                   + ("; the run stops where it reaches 1" if f.crack_limit else ""))
     from fretsim.runner import estimate
     cost = estimate(setup, filled, runs)
     total = cost["run_s"] + cost["companions_s"] + (planning if planning > 1.0 else 0.0)

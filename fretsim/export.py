@@ -15,7 +15,8 @@ def _col(name: str, units: str) -> str:
 
 
 def export_csv(res: Results, outdir: str | Path) -> list[Path]:
-    """Write history.csv, summary.csv, inputs.csv, fields.csv (long format: cycle, x, y, fields) and, for a
+    """Write history.csv, summary.csv, inputs.csv, fields.csv (long format: cycle, x, y, fields), with fatigue
+    subsurface.csv (cycle, z, x, the SWT and its plane) and, for a
     cycle with friction, fretting_loop.csv (cycle, displacement, force round each recorded loop) to outdir."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
@@ -53,6 +54,16 @@ def export_csv(res: Results, outdir: str | Path) -> list[Path]:
         rows.extend(zip(*(c.tolist() for c in cols)))
     write("fields.csv", ["cycle", "x [mm]", "y [mm]"] + [_col(k, res.units.get(f"fields/{k}", "")) for k in names],
           rows)
+    sub = res.subsurface
+    if sub:  # fretting fatigue: the flat's fields below its surface, long format (cycle, z, x)
+        names = [k for k in sub if k != "z"]
+        Z, X = np.meshgrid(sub["z"], res.x, indexing="ij")
+        rows = []
+        for s, cycle in enumerate(res.fields["cycle"]):
+            cols = [np.full(Z.size, cycle), Z.ravel(), X.ravel()] + [sub[k][s].ravel() for k in names]
+            rows.extend(zip(*(c.tolist() for c in cols)))
+        write("subsurface.csv", ["cycle", "z [mm]", "x [mm]"] + [_col(k, res.units.get(f"fields/{k}", ""))
+                                                                   for k in names], rows)
     loop = res.fretting_loop
     if loop.get("displacement") is not None and loop["displacement"].size:
         rows = [(int(c), float(u), float(q)) for c, us, qs in zip(loop["cycle"], loop["displacement"],

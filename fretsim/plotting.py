@@ -266,6 +266,8 @@ def _builders(res: Results, log_cycles: bool) -> dict:
         out["fretting"] = lambda: _fretting(res)
     if _dissipates(res.history):  # a run with a friction coefficient (format 1.5 on)
         out["energy_wear"] = lambda: _energy_wear(res)
+    if res.subsurface.get("swt") is not None and res.subsurface["swt"].size:
+        out["fatigue"] = lambda: _fatigue(res)
     return out
 
 
@@ -948,6 +950,122 @@ def _fretting(res: Results):
     return fig
 
 
+# --- fretting fatigue: the SWT field under the contact, and a sweep's life against the stroke ---------------------
+
+
+def _fatigue(res: Results):
+    """The stationary body's SWT field below its surface at the recorded state where it peaks (the peak over the
+    run and where the crack starts marked); the hot spot at true scale with the critical plane's trace at each
+    point; and the field's peak at each recorded state against cycles, with the crack cycle."""
+    sub, summary = res.subsurface, res.summary
+    swt, angle, z = sub["swt"], sub["swt_plane_angle"], sub["z"] * 1e3  # depths in µm
+    peaks = np.array([np.nanmax(f) if np.isfinite(f).any() else np.nan for f in swt])
+    k = int(np.nanargmax(peaks)) if np.isfinite(peaks).any() else len(peaks) - 1
+    field, x = swt[k], res.x * 1e3  # x in µm as well: the planes are drawn at their true angle
+    top = float(np.nanmax(field)) if np.isfinite(field).any() else 0.0
+    fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), gridspec_kw={"width_ratios": [1.8, 1.1, 1]})
+    if top > 0:
+        _swt_overview(axes[0], fig, field, x, z, top, summary)
+        _hot_spot(axes[1], field, angle[k], x, z, top)
+    axes[0].set_title(f"stationary body, {_cycles_label(res.fields['cycle'][k])}: SWT on the critical plane")
+    ax = axes[2]
+    ax.plot(res.fields["cycle"], peaks, "o-", ms=4, label="SWT peak at each recorded state")
+    crack = summary.get("cycles_to_crack_initiation", np.nan)
+    if np.isfinite(crack):
+        ax.axvline(crack, color="b", ls="--", lw=1.0, label="crack starts")
+    ax.set_xlabel("cycles")
+    ax.set_ylabel(f"SWT peak ({_unit(res, 'fields/swt')})")
+    ax.set_title(f"damage {summary.get('fatigue_damage', np.nan):.3g} of 1 at the end; {summary.get('damage_mode', '–')}",
+                 fontsize=10)
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    return fig
+
+
+def _swt_overview(ax, fig, field, x, z, top: float, summary: dict) -> None:
+    """The field where it reaches 1 % of its peak, depth downwards, the run's peak and the crack marked."""
+    cols = np.flatnonzero((field >= 0.01 * top).any(axis=0))
+    rows = np.flatnonzero((field >= 0.01 * top).any(axis=1))
+    pad = max(3, (cols[-1] - cols[0]) // 6)
+    xs = slice(max(0, cols[0] - pad), min(x.size, cols[-1] + pad + 1))
+    zs = slice(0, min(z.size, rows[-1] + 2))
+    pc = ax.pcolormesh(x[xs], z[zs], field[zs, xs], shading="nearest", cmap="magma_r", vmin=0.0, vmax=top)
+    fig.colorbar(pc, ax=ax, label="SWT (MPa)")
+    ax.plot(summary.get("swt_location_x_mm", np.nan) * 1e3, summary.get("swt_depth_um", np.nan), "c*", ms=12,
+            label=f"peak over the run: {summary.get('swt_max_MPa', np.nan):.3g} MPa")
+    crack = summary.get("cycles_to_crack_initiation", np.nan)
+    if np.isfinite(crack):
+        ax.plot(summary["crack_location_x_mm"] * 1e3, z[0], "bv", ms=9,
+                label=f"crack starts: cycle {crack:,.0f}".replace(",", " "))
+    ax.set_ylim(z[zs][-1], 0.0)
+    ax.set_xlabel("x, sliding direction (µm)")
+    ax.set_ylabel("depth below the surface (µm)")
+    ax.legend(fontsize=8, loc="lower right")
+
+
+def _hot_spot(ax, field, angle_deg, x, z, top: float) -> None:
+    """Around the field's peak at equal scale: the field and the critical plane's trace (perpendicular to its
+    normal, at φ from x towards the depth) at the points above a tenth of the peak."""
+    i, j = np.unravel_index(np.nanargmax(field), field.shape)
+    half = max(8.0 * float(x[1] - x[0]), 4.0 * float(z[min(i + 4, z.size - 1)]))
+    xs = np.flatnonzero(np.abs(x - x[j]) <= half)
+    zs = np.flatnonzero(z <= 1.2 * half)
+    ax.pcolormesh(x[xs], z[zs], field[np.ix_(zs, xs)], shading="nearest", cmap="magma_r", vmin=0.0, vmax=top)
+    length = 0.06 * half
+    step = max(1, xs.size // 12)
+    for r in zs[:: max(1, zs.size // 8)]:
+        for c in xs[::step]:
+            if field[r, c] >= 0.1 * top:
+                phi = math.radians(float(angle_deg[r, c]))
+                tx, tz = -math.sin(phi), math.cos(phi)
+                ax.plot([x[c] - length * tx, x[c] + length * tx], [z[r] - length * tz, z[r] + length * tz],
+                        color="c", lw=1.2)
+    ax.set_xlim(x[xs][0], x[xs][-1])
+    ax.set_ylim(z[zs][-1], 0.0)
+    ax.set_aspect("equal", adjustable="box")
+    ax.set_xlabel("x (µm)")
+    ax.set_title("at the peak, true scale: critical planes", fontsize=10)
+
+
+def fatigue_life_sweep(table: SweepTable):
+    """Crack-initiation life against the stroke, with wear and without (points whose wear coefficients are 0):
+    a point without a crack is drawn at its last cycle, pointing up (a lower bound); the gross-slip limit δ_t of
+    the unworn contact as a vertical line.  None where the points have no fatigue."""
+    rows = [r for r in table.rows if r.get("damage_mode") not in (None, "") and r.get("status") == "complete"]
+    if not rows:
+        return None
+    fig, ax = plt.subplots(figsize=(10.5, 4.6))
+
+    def worn(row) -> bool:  # a point that sets every wear coefficient it names to 0 runs without wear
+        given = [_AS_WRITTEN.match(str(v)) or re.match(r"^\s*([-+0-9.eE]+)\s*$", str(v)) for k, v in row.items()
+                 if k.endswith("wear_coefficient")]
+        return not given or any(m is None or float(m.group(1)) != 0 for m in given)
+
+    for label, colour, pick in (("with wear", "C0", True), ("without wear (k = 0)", "C3", False)):
+        group = sorted((r for r in rows if worn(r) == pick), key=lambda r: _in_unit(r.get("loading.stroke"), _TO_UM))
+        if not group:
+            continue
+        stroke = np.array([_in_unit(r.get("loading.stroke"), _TO_UM) for r in group])
+        life = np.array([_row_number(r, "cycles_to_crack_initiation") for r in group])
+        ran = np.array([_row_number(r, "cycles") for r in group])
+        ax.plot(stroke, np.where(np.isfinite(life), life, ran), "-", color=colour, lw=1.0, alpha=0.6)
+        ax.plot(stroke[np.isfinite(life)], life[np.isfinite(life)], "o", color=colour, label=label)
+        ax.plot(stroke[~np.isfinite(life)], ran[~np.isfinite(life)], "^", color=colour, mfc="none",
+                label=f"{label}: no crack by the run's end")
+    d_t = np.array([_row_number(r, "gross_slip_stroke_um") for r in rows])
+    if np.isfinite(d_t).any():
+        ax.axvline(float(np.nanmedian(d_t)), color="k", ls=":", lw=1.0, label="gross-slip limit δ_t (unworn)")
+    ax.set_xscale("log")
+    ax.set_yscale("log")
+    ax.set_xlabel("stroke amplitude δ (µm)")
+    ax.set_ylabel("cycles to crack initiation")
+    ax.set_title(f"{Path(table.path).name}: fretting fatigue life against the stroke")
+    ax.grid(alpha=0.3, which="both")
+    ax.legend(fontsize=8, loc="upper left", bbox_to_anchor=(1.02, 1.0))  # (the curve's minimum sits low centre)
+    fig.subplots_adjust(left=0.09, right=0.64, bottom=0.12)
+    return fig
+
+
 ENERGY = "cumulative_dissipated_energy_J"
 BODIES = ("moving", "stationary")
 
@@ -1054,9 +1172,10 @@ def plot_sweep(table: SweepTable, outdir: str | Path, fmt: str = "png", dpi: int
         return uncertainty_bands(table, outdir, fmt, dpi)
     axes = list(table.axes)
     fouvry = energy_wear_sweep(table)
-    if not axes and fouvry is None:
+    life = fatigue_life_sweep(table) if any(r.get("damage_mode") for r in table.rows) else None
+    if not axes and fouvry is None and life is None:
         raise ResultsFileError(f"{table.path}: the sweep has no axes (a list of points): nothing to draw curves over")
-    builders = {}
+    builders = {} if life is None else {"sweep_fatigue_life": lambda: life}
     if is_fretting_sweep(table):
         builders.update(fretting_figures(table, build=False))
         axes = [a for a in axes if a not in FRETTING_AXES]

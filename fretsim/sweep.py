@@ -712,7 +712,7 @@ def _table_image(sweep: Sweep, rows: list) -> bytes:
                 c.attrs["units"] = units or ""
                 c.dims[0].attach_scale(ds)
         coords = " ".join(k for k in f if k not in ("point",)) if sweep.mode != "product" else ""
-        texts = {"status", "regime", "limit_reached"}  # the summary's words; every other output is a number
+        texts = {"status"} | {k for k, u in SUMMARY_UNITS.items() if u == ""}  # the summary's words (unit "")
         for name, data, dtype in ([("status", [r["status"] for r in rows], text)] +
                                   [(k, [r.get(k, "" if k in texts else float("nan")) for r in rows],
                                     text if k in texts else float) for k in outputs]):

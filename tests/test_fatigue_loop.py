@@ -157,7 +157,11 @@ def test_the_loops_hertz_contact_has_its_largest_shear_0_300_p0_at_0_786_a():
     the maximum is flat there) and the depth within the layer spacing."""
     out = run(load_case(TI, ["loading.cycles=0", "grid.error_estimate=none", "loading.friction_coefficient=0.001"]))
     s, hz = out.summary, out.setup
-    p0, a = 636.376, 0.120046  # the case's Hertz p0 and a (its inputs: hertz_peak_pressure, hertz_half_width_x)
+    case = out.case
+    e_star = case.moving.youngs_modulus / (2 * (1 - case.moving.poissons_ratio ** 2))  # equal bodies
+    load = case.loading.normal_load / case.geometry.length  # N/mm
+    a = math.sqrt(4 * load * case.geometry.radius / (math.pi * e_star))  # Johnson (4.43), (4.45)
+    p0 = 2 * load / (math.pi * a)
     assert s["max_shear_stress_MPa"] == pytest.approx(0.300 * p0, rel=0.01)
     assert s["max_shear_stress_depth_um"] * 1e-3 == pytest.approx(0.786 * a, rel=0.2)
     assert hz.fatigue is not None
@@ -240,3 +244,50 @@ def test_the_crack_limit_and_the_stresses_need_the_constants_and_the_cli_says_so
     assert result.exit_code != 0 and "Traceback" not in result.output
     assert "limits.crack_initiation" in result.output and "materials.stationary.fatigue" in result.output
     assert not (tmp_path / "m.h5").exists()
+
+
+def test_the_fatigue_figure_marks_the_runs_swt_peak_and_the_crack_and_export_writes_the_field(cracked, tmp_path):
+    from fretsim.export import export_csv
+    from fretsim.plotting import figures
+    outcome, path = cracked
+    res = read_results(path)
+    fig = figures(res, names=["fatigue"])["fatigue"]
+    field_ax = fig.axes[0]
+    marks = {line.get_label(): (line.get_xdata()[0], line.get_ydata()[0]) for line in field_ax.get_lines()
+             if line.get_label().startswith(("peak", "crack"))}
+    peak = next(v for k, v in marks.items() if k.startswith("peak"))
+    assert peak == pytest.approx((res.summary["swt_location_x_mm"] * 1e3, res.summary["swt_depth_um"]))
+    crack = next(v for k, v in marks.items() if k.startswith("crack"))
+    assert crack[0] == pytest.approx(res.summary["crack_location_x_mm"] * 1e3)
+    paths = export_csv(res, tmp_path)
+    sub = tmp_path / "subsurface.csv"
+    assert sub in paths
+    lines = sub.read_text().splitlines()
+    assert lines[0].startswith("cycle,z [mm],x [mm],swt [MPa]")
+    assert len(lines) - 1 == res.fields["cycle"].size * res.subsurface["z"].size * res.x.size
+
+
+def test_a_sweep_over_stroke_draws_the_life_with_wear_and_without(tmp_path):
+    """Two strokes, each with wear and without: the figure's two curves hold the points' crack cycles (or, where
+    none started, their last cycle as a lower bound)."""
+    from fretsim.plotting import fatigue_life_sweep
+    from fretsim.results import read_sweep_table
+    from fretsim.sweep import load_sweep, run_sweep
+    sweep_file = tmp_path / "s.yaml"
+    sweep_file.write_text(f"base: {TI}\nset: [loading.cycles=20000, grid.error_estimate=none]\nmode: points\npoints:\n"
+                          "  - {loading.stroke: 5 um}\n  - {loading.stroke: 10 um}\n"
+                          "  - {loading.stroke: 5 um, materials.moving.wear_coefficient: 0 1/MPa, "
+                          "materials.stationary.wear_coefficient: 0 1/MPa}\n"
+                          "  - {loading.stroke: 10 um, materials.moving.wear_coefficient: 0 1/MPa, "
+                          "materials.stationary.wear_coefficient: 0 1/MPa}\n")
+    run_sweep(load_sweep(sweep_file), tmp_path / "out")
+    table = read_sweep_table(tmp_path / "out")
+    fig = fatigue_life_sweep(table)
+    drawn = {line.get_label(): list(zip(line.get_xdata(), line.get_ydata())) for line in fig.axes[0].get_lines()}
+    for row in table.rows:
+        life = float(row["cycles_to_crack_initiation"])
+        worn = not row.get("materials.stationary.wear_coefficient")
+        label = ("with wear" if worn else "without wear (k = 0)") + ("" if math.isfinite(life) else
+                                                                     ": no crack by the run's end")
+        stroke = float(row["loading.stroke"].split()[0])
+        assert (stroke, life if math.isfinite(life) else float(row["cycles"])) in drawn[label]
