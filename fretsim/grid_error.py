@@ -134,10 +134,13 @@ FATIGUE_KEYS = ("estimated_error_cycles_to_crack", "estimated_error_swt_max")
 def fatigue_estimates(fine: dict, coarse: dict) -> dict:
     """The grid's part of the fatigue figures' relative error, read directly from the companion's (the crack cycle
     follows the SWT's peak at the contact's edge, which converges like the pressure's peak: no Richardson factor is
-    claimed), plus the depths' stepping part for the crack cycle.  NaN where either run has no crack."""
+    claimed), plus the depths' stepping part and the fatigue states' spacing part (Miner's sum over every other
+    state) for the crack cycle.  NaN where either run has no crack."""
     crack, crack_c = fine.get("cycles_to_crack_initiation", math.nan), coarse.get("cycles_to_crack_initiation",
                                                                                  math.nan)
-    out = {"estimated_error_cycles_to_crack": (abs(crack - crack_c) / crack + fine["error_estimate_depth"])
+    states = fine.get("fatigue_states_error", math.nan)
+    out = {"estimated_error_cycles_to_crack": (abs(crack - crack_c) / crack + fine["error_estimate_depth"]
+                                               + (states if math.isfinite(states) else 0.0))
            if math.isfinite(crack) and math.isfinite(crack_c) and crack > 0 else math.nan}
     swt, swt_c = fine.get("swt_max_MPa", math.nan), coarse.get("swt_max_MPa", math.nan)
     out["estimated_error_swt_max"] = _relative(swt, swt_c) if math.isfinite(swt) and math.isfinite(swt_c) else math.nan

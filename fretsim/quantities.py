@@ -124,6 +124,7 @@ SUMMARY: dict[str, Figure] = {
     "crack_location_x_mm": Figure("mm", nan=True),
     "fatigue_damage": Figure("1"),
     "damage_mode": Figure(""),
+    "fatigue_states_error": Figure("1", nan=True),  # the crack cycle's (or damage's) change with half the states
     "estimated_error_cycles_to_crack": Figure("1", nan=True),  # no crack in the run or its companion, or none run
     "estimated_error_swt_max": Figure("1", nan=True),
 }

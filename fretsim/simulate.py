@@ -14,6 +14,7 @@ units of their own.
 """
 from __future__ import annotations
 
+import math
 import time
 from dataclasses import dataclass, field
 from typing import Callable, Optional, Protocol
@@ -154,9 +155,7 @@ class _Loop:
         self.observers = observers
         self.progress = progress
         self.t0 = time.perf_counter()
-        self.detailed = set(setup.snapshots) | (set(setup.fatigue.states) if setup.fatigue is not None else set())
-        fatigue = {n for n in setup.fatigue.states if n <= setup.cycles} if setup.fatigue is not None else set()
-        self.base_stops = sorted(set(setup.snapshots) | fatigue | {setup.cycles} | set(setup.loading.boundaries))
+        self.base_stops = sorted(set(setup.snapshots) | {setup.cycles} | set(setup.loading.boundaries))
         self.stops = list(self.base_stops)  # and, with wear limits, the crossings a retaken step lands on
         # block ends that are not also recorded states (snapshots, the last cycle)
         self.boundaries = set(setup.loading.boundaries) - set(setup.snapshots) - {setup.cycles}
@@ -227,7 +226,7 @@ class _Loop:
             return self.model.solve(self.h_m if h_m is None else h_m, self.h_s if h_s is None else h_s, self.normal,
                                     guess, step=implicit, memory=self.memory, cycle=cycle,
                                     detail=detail or cycle in self.s.snapshots or (
-                                        TRACTIONS if cycle in self.detailed else False))
+                                        TRACTIONS if self._fatigue_due(cycle) else False))
         except CycleError as exc:
             raise NumericalFailure(f"{exc} at cycle {cycle}", self.n) from None
 
@@ -274,6 +273,15 @@ class _Loop:
         checks.check_body(s.limits, s.grid, self.h_m, self.p, self.n)
         return step
 
+    def _fatigue_due(self, cycle: int) -> bool:
+        """Whether a step ending at ``cycle`` reaches the next fatigue state: the fatigue is evaluated at the first
+        step at or past each (the states are not stops: the stepping takes its own steps, each detailed as due)."""
+        if self.miner is None:
+            return False
+        if self.miner.damage is None:
+            return True
+        return cycle >= next((n for n in self.s.fatigue.states if n > self.miner.cycle), math.inf)
+
     def _fatigue(self, step: Step) -> bool:
         """The flat's fatigue at a detailed state (or at a wear limit's, detailed now) added to Miner's sum; True
         where it just reached 1 and the case stops there."""
@@ -284,10 +292,15 @@ class _Loop:
             if not step.is_snapshot:
                 return False
             cyc = self.cycle_at(self.n, self.p, detail=True)
-        step.fatigue = evaluate(s.fatigue, s.grid.x, s.grid.dx, s.fatigue.curve.youngs_modulus, cyc)
+        step.fatigue = evaluate(s.fatigue, s.grid.x, s.grid.dx, s.fatigue.curve.youngs_modulus, cyc,
+                                full=step.is_snapshot)
         had = self.miner.crack is not None
         self.miner.add(self.n, step.fatigue)
-        return s.fatigue.crack_limit and not had and self.miner.crack is not None
+        stop = s.fatigue.crack_limit and not had and self.miner.crack is not None
+        if stop and not step.fatigue.full:  # the run ends here: this state is recorded, with its fields in full
+            step.fatigue = evaluate(s.fatigue, s.grid.x, s.grid.dx, s.fatigue.curve.youngs_modulus, cyc)
+            self.miner.peak(step.fatigue)
+        return stop
 
     def restored_cycle(self) -> Cycle:
         """The cycle at the restored state: rebuilt from its pressure where the rates are linear in it, else solved

@@ -87,10 +87,11 @@ def stresses(pressure: np.ndarray, shear: np.ndarray, dx: float, z: np.ndarray) 
     return StressHistory(out[0], out[1], out[2])
 
 
-def window(pressure: np.ndarray, margin: float = 1.0, least: int = 8) -> slice:
+def window(pressure: np.ndarray, margin: float = 0.5, least: int = 8) -> slice:
     """The columns the flat's stresses are computed over: those any state loads, widened each side by ``margin``
-    times the loaded width (at least ``least`` elements).  Beyond, a strip load's stresses fall off as 1/r: at a
-    contact width from the edge they are a small share of the contact's, and so is any fatigue damage there."""
+    times the loaded width (at least ``least`` elements).  Beyond, a strip load's stresses fall off as 1/r: half a
+    contact width from the edge they are a small share of the contact's, and the fatigue damage, as SWT^3 to ^5,
+    a far smaller one."""
     loaded = np.flatnonzero((pressure > 0).any(axis=0))
     nx = pressure.shape[1]
     if not loaded.size:

@@ -126,7 +126,8 @@ FINE_HALF = 4  # ... then every degree within ±4° of each point's two best: th
 #               whose peaks the 5° pass has bracketed (tests/test_fatigue_loop.py: equal to the full search)
 
 
-def swt_search(history: tuple, youngs: float, poisson: float, slides: Optional[dict] = None) -> CriticalPlane:
+def swt_search(history: tuple, youngs: float, poisson: float, slides: Optional[dict] = None,
+               skip: float = 0.0) -> CriticalPlane:
     """:func:`swt_2d`'s critical plane to the same degree in a fraction of the work: a 5° pass, then each point's
     two best planes' neighbourhoods degree by degree.  On a plane of normal angle φ the normal stress is
     a + b·cos 2φ + c·sin 2φ (a, b, c the mean, half-difference and shear of the in-plane stresses), and so is the
@@ -136,7 +137,10 @@ def swt_search(history: tuple, youngs: float, poisson: float, slides: Optional[d
     ``slides`` {state k: m}: the states reached by sliding rigidly, with their tractions as they are, over m
     elements of the last axis (signed) since the state before — so that on the way the field at a point was state
     k's m' elements further on, for every m' between 0 and m: each such state counts as the extremes over that
-    window, exactly, however few states the cycle was cut into."""
+    window, exactly, however few states the cycle was cut into.
+
+    ``skip`` > 0: points whose bound max σ₁·(max ε₁ − min ε₃)/2 (no plane's SWT exceeds it) is below ``skip`` of
+    the field's largest bound are not searched (0 there): for the damage alone, where they count nothing."""
     sxx, szz, sxz = (np.asarray(a, dtype=float) for a in history)
     exx, ezz, gxz = plane_strain_strains(sxx, szz, sxz, youngs, poisson)
     shape = sxx.shape[1:]
@@ -144,26 +148,82 @@ def swt_search(history: tuple, youngs: float, poisson: float, slides: Optional[d
     s_abc = tuple(flat(a) for a in (0.5 * (sxx + szz), 0.5 * (sxx - szz), sxz))
     e_abc = tuple(flat(a) for a in (0.5 * (exx + ezz), 0.5 * (exx - ezz), 0.5 * gxz))
     slides = {k: m for k, m in (slides or {}).items() if m}
+    rows, cols = slice(None), slice(None)
+    if skip > 0:  # the bounding box of the points worth searching (with the windows' reach along x)
+        bound = _bound(s_abc, e_abc, slides)
+        on = bound >= skip * bound.max() if bound.size and bound.max() > 0 else np.zeros(bound.shape, bool)
+        if not on.any():
+            return CriticalPlane(np.zeros(shape), np.zeros(shape))
+        r, c = np.flatnonzero(on.any(axis=1)), np.flatnonzero(on.any(axis=0))
+        reach = max((abs(m) for m in slides.values()), default=0)
+        rows = slice(int(r[0]), int(r[-1]) + 1)
+        cols = slice(max(0, int(c[0]) - reach), int(c[-1]) + reach + 1)
+    plane = _search_field(tuple(a[:, rows, cols] for a in s_abc), tuple(a[:, rows, cols] for a in e_abc), slides)
+    best, where = np.zeros(s_abc[0].shape[1:]), np.zeros(s_abc[0].shape[1:])
+    best[rows, cols], where[rows, cols] = plane
+    return CriticalPlane(best.reshape(shape), where.reshape(shape))
+
+
+def _bound(s_abc, e_abc, slides: dict) -> np.ndarray:
+    """max σ₁·(max ε₁ − min ε₃)/2 over the history at each point: no plane's SWT exceeds it."""
+    def extreme(abc, sign, pick):
+        v = abc[0] + sign * np.hypot(abc[1], abc[2])
+        out = v.max(axis=0) if pick is np.maximum else v.min(axis=0)
+        for k, m in slides.items():
+            out = pick(out, _sliding(v[k], m, pick))
+        return out
+    return (np.maximum(extreme(s_abc, 1, np.maximum), 0.0) * 0.5 *
+            (extreme(e_abc, 1, np.maximum) - extreme(e_abc, -1, np.minimum)))
+
+
+def _refine(coarse: np.ndarray, value) -> tuple:
+    """From the 5° pass's values (angle, point): each point's two best planes' neighbourhoods degree by degree,
+    where the 5° value is at least FINE_SHARE of the peak (a fretting cycle's mirror-image planes often tie to
+    round-off, and the pass about the wrong one of two near-equal peaks can miss the best by 10 % or more).
+    ``value(phi, selection)`` → the SWT at the selected points on their planes φ."""
     step = np.pi / COARSE_ANGLES
-    coarse = np.array([_value(s_abc, e_abc, slides, phi) for phi in np.arange(COARSE_ANGLES) * step])
-    # each point's two best 5° planes: a fretting cycle's mirror-image planes often tie to round-off, and the
-    # degree-by-degree pass about the wrong one of two near-equal peaks can miss the best by 10 % or more
     order = np.argsort(coarse, axis=0)
     best = np.take_along_axis(coarse, order[-1:], 0)[0]
     where = order[-1] * step
-    rows, cols = np.nonzero(best >= FINE_SHARE * best.max()) if best.size and best.max() > 0 else ((), ())
-    rows, cols = np.asarray(rows, int), np.asarray(cols, int)
-    top, second = order[-1][rows, cols] * step, order[-2][rows, cols] * step
-    b, w = best[rows, cols], where[rows, cols]
-    for centre in (top, second):
+    sel = np.flatnonzero(best >= FINE_SHARE * best.max()) if best.max() > 0 else np.zeros(0, int)
+    b, w = best[sel], where[sel]
+    for centre in (order[-1][sel] * step, order[-2][sel] * step):
         for k in range(-FINE_HALF, FINE_HALF + 1):
             if k:
                 phi = np.mod(centre + k * (np.pi / ANGLES), np.pi)
-                v = _value_at(s_abc, e_abc, slides, phi, rows, cols)
+                v = value(phi, sel)
                 better = v > b
                 b, w = np.where(better, v, b), np.where(better, phi, w)
-    best[rows, cols], where[rows, cols] = b, w
-    return CriticalPlane(best.reshape(shape), where.reshape(shape))
+    best[sel], where[sel] = b, w
+    return best, where
+
+
+def _value_pts(s_pts: tuple, e_pts: tuple, phi) -> np.ndarray:
+    """SWT on the plane(s) φ at points whose whole history (states and windows) is gathered: (history, points)."""
+    c2, s2 = np.cos(2.0 * phi), np.sin(2.0 * phi)
+    sn = s_pts[0] + s_pts[1] * c2 + s_pts[2] * s2
+    en = e_pts[0] + e_pts[1] * c2 + e_pts[2] * s2
+    return np.maximum(sn.max(axis=0), 0.0) * 0.5 * (en.max(axis=0) - en.min(axis=0))
+
+
+def _search_field(s_abc, e_abc, slides: dict) -> tuple:
+    """The search over a (state, leading, x) field: the 5° pass by running filters along x (each plane one
+    array operation whatever the windows), the second pass at the points that need it, their windows gathered."""
+    step = np.pi / COARSE_ANGLES
+    coarse = np.array([_value(s_abc, e_abc, slides, phi) for phi in np.arange(COARSE_ANGLES) * step])
+    shape = coarse.shape[1:]
+    nx = shape[-1]
+
+    gathered: dict = {}  # the selection's histories, gathered once for the second pass's sixteen planes
+
+    def value(phi, sel):
+        if "pts" not in gathered:
+            rows, cols = np.divmod(sel, nx)
+            gathered["pts"] = (_at_points(s_abc, slides, rows, cols), _at_points(e_abc, slides, rows, cols))
+        return _value_pts(*gathered["pts"], phi)
+
+    best, where = _refine(coarse.reshape(COARSE_ANGLES, -1), value)
+    return best.reshape(shape), where.reshape(shape)
 
 
 def _value(s_abc, e_abc, slides: dict, phi: float) -> np.ndarray:
@@ -183,25 +243,19 @@ def _value(s_abc, e_abc, slides: dict, phi: float) -> np.ndarray:
     return np.maximum(s_hi, 0.0) * 0.5 * (e_hi - e_lo)
 
 
-def _value_at(s_abc, e_abc, slides: dict, phi: np.ndarray, rows: np.ndarray, cols: np.ndarray) -> np.ndarray:
-    """SWT at the points (rows, cols), each on its own plane φ: a sliding state's window read position by
-    position on that point's plane."""
-    c2, s2 = np.cos(2.0 * phi), np.sin(2.0 * phi)
-    nx = s_abc[0].shape[-1]
-
-    def extremes(abc):
-        values = abc[0][:, rows, cols] + abc[1][:, rows, cols] * c2 + abc[2][:, rows, cols] * s2
-        hi, lo = values.max(axis=0), values.min(axis=0)
+def _at_points(abc: tuple, slides: dict, rows: np.ndarray, cols: np.ndarray) -> tuple:
+    """(a, b, c) at the points (rows, cols) over the states and, for each sliding state, every position of its
+    window (the state's values m' elements further on, held at the grid's ends): arrays (history, points), so that
+    each point's own planes are evaluated in one pass."""
+    nx = abc[0].shape[-1]
+    out = []
+    for arr in abc:
+        parts = [arr[:, rows, cols]]
         for k, m in slides.items():
-            for j in range(1, abs(m) + 1):
-                at = np.clip(cols + (j if m > 0 else -j), 0, nx - 1)
-                v = abc[0][k, rows, at] + abc[1][k, rows, at] * c2 + abc[2][k, rows, at] * s2
-                hi, lo = np.maximum(hi, v), np.minimum(lo, v)
-        return hi, lo
-
-    s_hi, _ = extremes(s_abc)
-    e_hi, e_lo = extremes(e_abc)
-    return np.maximum(s_hi, 0.0) * 0.5 * (e_hi - e_lo)
+            at = np.clip(cols[None, :] + np.sign(m) * np.arange(1, abs(m) + 1)[:, None], 0, nx - 1)
+            parts.append(arr[k][rows[None, :], at])
+        out.append(np.concatenate(parts, axis=0))
+    return tuple(out)
 
 
 def _sliding(values: np.ndarray, m: int, pick) -> np.ndarray:
