@@ -20,7 +20,6 @@ from dataclasses import dataclass
 from functools import lru_cache
 
 import numpy as np
-from scipy import fft
 
 from fretsim.fatigue.stresses import _normal_terms, _shear_terms
 
@@ -61,6 +60,7 @@ def on_flat(values: np.ndarray, travel: np.ndarray, x: np.ndarray, dx: float) ->
 @lru_cache(maxsize=8)
 def _kernels(nx: int, dx: float, z_key: tuple) -> tuple:
     """The strips' kernels' FFTs at every depth: (length, normal (depth, 3, freq), shear (depth, 3, freq))."""
+    from scipy import fft  # (here, not at import: planning a run must not pay for scipy's FFT)
     length = fft.next_fast_len(2 * nx - 1, real=True)
     offsets = np.arange(-(nx - 1), nx) * dx  # x_i − ξ_j
     normal, shear = [], []
@@ -76,6 +76,7 @@ def _kernels(nx: int, dx: float, z_key: tuple) -> tuple:
 def stresses(pressure: np.ndarray, shear: np.ndarray, dx: float, z: np.ndarray) -> StressHistory:
     """The flat's stresses at every (state, depth, centre) under the states' strip tractions (states, nx) laid on
     its grid (:func:`on_flat`): pressure compressive, shear along +x."""
+    from scipy import fft
     states, nx = pressure.shape
     length, k_n, k_s = _kernels(nx, float(dx), tuple(float(v) for v in z))
     p_hat = fft.rfft(pressure, length, axis=-1)[:, None, :]  # (states, 1, freq)

@@ -19,7 +19,6 @@ from dataclasses import dataclass
 from typing import Optional
 
 import numpy as np
-from scipy import ndimage
 
 ANGLES = 180  # plane normals searched in 2D: every degree (the parameter is π-periodic in the angle)
 
@@ -261,6 +260,7 @@ def _at_points(abc: tuple, slides: dict, rows: np.ndarray, cols: np.ndarray) -> 
 def _sliding(values: np.ndarray, m: int, pick) -> np.ndarray:
     """pick (np.maximum or np.minimum) over the window x … x + m along the last axis (m signed), the field held at
     its edges: scipy's running filter, O(n) whatever the window."""
+    from scipy import ndimage  # (here, not at import: planning a run must not pay for it)
     n, w = values.shape[-1], abs(m) + 1
     run = ndimage.maximum_filter1d if pick is np.maximum else ndimage.minimum_filter1d
     padded = np.concatenate([np.repeat(values[..., :1], w, axis=-1), values,
