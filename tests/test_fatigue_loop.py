@@ -71,7 +71,10 @@ def _sliding_history():
     return x, dx, z, ps, qs, np.array(travels), fine
 
 
-def test_a_rigidly_sliding_state_counts_every_position_on_its_way():
+@pytest.mark.parametrize("gather", [0, 100])  # the 5° pass by running filters, and with the histories gathered
+def test_a_rigidly_sliding_state_counts_every_position_on_its_way(gather, monkeypatch):
+    import fretsim.fatigue.swt as swt
+    monkeypatch.setattr(swt, "GATHER", gather)
     """Four states (each end of each half-stroke) with the slides marked give the SWT of all 22 positions
     computed one by one: the sliding maximum is exact on the grid (1e-12)."""
     x, dx, z, ps, qs, travels, fine = _sliding_history()

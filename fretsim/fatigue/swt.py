@@ -121,6 +121,8 @@ def swt_2d(history: tuple, youngs: float, poisson: float, angles: int = ANGLES) 
 
 COARSE_ANGLES = 36  # the fast search's first pass: every 5°
 FINE_SHARE = 0.01  # ... refined where it found at least this share of the field's peak
+GATHER = 2  # windows' positions, per state, up to which the 5° pass gathers each point's whole history (beyond,
+#             running filters per plane were faster: McColl-size fields, measured)
 FINE_HALF = 4  # ... then every degree within ±4° of each point's two best: the 1° optimum of a π-periodic function
 #               whose peaks the 5° pass has bracketed (tests/test_fatigue_loop.py: equal to the full search)
 
@@ -206,10 +208,17 @@ def _value_pts(s_pts: tuple, e_pts: tuple, phi) -> np.ndarray:
 
 
 def _search_field(s_abc, e_abc, slides: dict) -> tuple:
-    """The search over a (state, leading, x) field: the 5° pass by running filters along x (each plane one
-    array operation whatever the windows), the second pass at the points that need it, their windows gathered."""
+    """The search over a (state, leading, x) field: the 5° pass over every point's history gathered (the states and
+    each window's positions: one array operation per plane) where the windows are short against the states, else
+    by running filters along x; the second pass at the points that need it, their windows gathered."""
     step = np.pi / COARSE_ANGLES
-    coarse = np.array([_value(s_abc, e_abc, slides, phi) for phi in np.arange(COARSE_ANGLES) * step])
+    if sum(abs(m) for m in slides.values()) <= GATHER * s_abc[0].shape[0]:
+        rows, cols = (a.ravel() for a in np.indices(s_abc[0].shape[1:]))
+        s_all, e_all = _at_points(s_abc, slides, rows, cols), _at_points(e_abc, slides, rows, cols)
+        coarse = np.array([_value_pts(s_all, e_all, phi) for phi in np.arange(COARSE_ANGLES) * step])
+        coarse = coarse.reshape((COARSE_ANGLES,) + s_abc[0].shape[1:])
+    else:
+        coarse = np.array([_value(s_abc, e_abc, slides, phi) for phi in np.arange(COARSE_ANGLES) * step])
     shape = coarse.shape[1:]
     nx = shape[-1]
 
