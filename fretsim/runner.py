@@ -289,6 +289,8 @@ def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from:
                                 f"resume with `fretsim run --resume {output}`")
         raise
     setup, filled, plan = sink.setup, sink.filled, sink.plan  # (on the grid the run ended on)
+    if counter.last is not None and setup.fatigue is not None:
+        _yield_note(filled, _summary(setup, counter, t0), counter)
     if status == "complete" and counter.last is not None:
         _estimate_errors(setup, filled, plan, counter, sink, t0, runs)
     previous = _ignore_signals()  # a Ctrl-C in the last instant must not make a complete run look interrupted
@@ -406,6 +408,19 @@ def _estimate_errors(setup, filled, plan, counter, sink: _Sink, t0, runs: SideRu
         counter.notes.append(f"the grid's error was not estimated: {type(exc).__name__}: {str(exc)[:160]}")
         counter.extra = {k: float("nan") for k in grid_error.KEYS + (grid_error.LIMIT_KEY,)}
     counter.extra["grid_error_wall_time_s"] = time.perf_counter() - started
+
+
+def _yield_note(filled: Case, summary: dict, counter: "_Counter") -> None:
+    """A fatigue run whose flat's largest shear stress passes Tresca's yield (σ_y/2, with the flat's yield strength
+    given): said, since the elastic stresses there, and the SWT life from them, are beyond the model's range (a
+    worn partial-slip contact concentrates its pressure on the stick zone's edge)."""
+    sy = filled.stationary.yield_strength
+    shear = summary.get("max_shear_stress_MPa", float("nan"))
+    if sy is not None and math.isfinite(shear) and shear > 0.5 * sy:
+        counter.notes.append(f"the flat's largest shear stress {shear:.4g} MPa (at a recorded state, "
+                             f"{summary['max_shear_stress_depth_um']:.3g} µm deep) passes Tresca's yield σ_y/2 = "
+                             f"{0.5 * sy:.4g} MPa: the flat yields there, where the elastic stresses and the "
+                             f"fatigue life from them do not follow it (the life is the elastic model's)")
 
 
 def _ignore_signals() -> dict:

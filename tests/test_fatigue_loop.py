@@ -319,3 +319,12 @@ def test_fatigue_changes_no_wear_result():
     assert with_f["contact_solves"] == without["contact_solves"]
     for key in ("max_wear_depth_stationary_um", "wear_volume_stationary_mm3", "scar_width_stationary_mm"):
         assert with_f[key] == pytest.approx(without[key], rel=1e-10), key
+
+
+@pytest.mark.parametrize("yield_strength, said", [("300 MPa", True), ("3000 MPa", False)])
+def test_a_fatigue_run_says_where_the_flats_shear_passes_trescas_yield(yield_strength, said):
+    """The unworn contact's largest shear (about 0.3 p₀ = 190 MPa below the surface, more at it with μ = 0.8)
+    against σ_y/2: 150 MPa is passed, 1500 MPa is not."""
+    out = run(load_case(TI, ["loading.cycles=0", "grid.error_estimate=none",
+                             f"materials.stationary.yield_strength={yield_strength}"]))
+    assert any("Tresca" in n for n in out.notes) == said
