@@ -14,6 +14,10 @@
 
 ``--resolved`` adds the resolved stroke (2D and 3D, 3 pairs each) to the pairs against the old tree.
 
+4. ``--ratio [--3d]``: issue 30's target, the resolved stroke against the mid-stroke Coulomb run on the same grid,
+   side by side in this tree (McColl 185 N 2D, μ 0.9, grid.error_estimate none; 5 pairs, fresh processes, run in
+   turn; ``--3d`` adds one 3D pair, about two minutes): the ratio of the loop times, pair by pair.
+
 Prints tables; writes scripts/out/bench_friction.{txt,csv,png}.
 """
 from __future__ import annotations
@@ -67,6 +71,26 @@ def versus(baseline: str, pairs: int, say: Report, rows: list, models=VERSUS) ->
             f"{max(ratios):>7.3f}")
         rows.append({"what": f"{label} vs baseline", "this_s": float(np.median(a_s)), "baseline_s": float(np.median(b_s)),
                      "ratio_median": float(np.median(ratios)), "ratio_min": min(ratios), "ratio_max": max(ratios)})
+
+
+def ratio(dims: tuple, say: Report, rows: list) -> None:
+    """The resolved stroke's loop time over the mid-stroke run's, pair by pair (each pair back to back)."""
+    case = str(ROOT / "cases" / "mccoll_185N.yaml")
+    say("the resolved stroke against mid-stroke, McColl 185 N, μ 0.9, 18 000 cycles (fresh processes, in turn)")
+    say(f"{'dim':<5}{'pairs':>6}{'resolved s':>12}{'mid s':>9}{'ratio':>8}{'min':>7}{'max':>7}")
+    for dim in dims:
+        pairs = 5 if dim == "2d" else 1
+        base = [MU, "model.slip=coulomb", f"model.dimension={dim}", "grid.error_estimate=none"]
+        res, mid = [], []
+        for _ in range(pairs):
+            res.append(loop_seconds(str(ROOT), case, base + ["model.stroke=resolved"]))
+            mid.append(loop_seconds(str(ROOT), case, base + ["model.stroke=mid_stroke"]))
+        r = [a / b for a, b in zip(res, mid)]
+        say(f"{dim:<5}{pairs:>6}{np.median(res):>12.3f}{np.median(mid):>9.3f}{np.median(r):>8.2f}{min(r):>7.2f}"
+            f"{max(r):>7.2f}")
+        rows.append({"what": f"resolved / mid-stroke, {dim}", "this_s": float(np.median(res)),
+                     "baseline_s": float(np.median(mid)), "ratio_median": float(np.median(r)),
+                     "ratio_min": min(r), "ratio_max": max(r)})
 
 
 def main(quick: bool = False, baseline: str = "", vs_only: bool = False, resolved: bool = False) -> None:
@@ -144,5 +168,13 @@ def main(quick: bool = False, baseline: str = "", vs_only: bool = False, resolve
 
 if __name__ == "__main__":
     args = sys.argv[1:]
+    if "--ratio" in args:
+        say_, rows_ = Report(), []
+        ratio(("2d", "3d") if "--3d" in args else ("2d",), say_, rows_)
+        OUT.mkdir(parents=True, exist_ok=True)
+        say_.write(OUT / "bench_friction_ratio.txt")
+        write_csv(rows_, OUT / "bench_friction_ratio.csv")
+        print(f"wrote {OUT / 'bench_friction_ratio.txt'}, .csv")
+        sys.exit(0)
     vs = args[args.index("--vs") + 1] if "--vs" in args else os.environ.get("FRETSIM_BASELINE", "")
     main("--quick" in args, vs, "--vs-only" in args, "--resolved" in args)

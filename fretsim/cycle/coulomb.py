@@ -56,10 +56,21 @@ CORRECTIONS = 1  # fixed-point corrections of an implicit step's gap for the wea
 SPREAD_TO_CORRECT = 0.1  # ... where the slip varies by more than this share of its largest (1 − mean/max): in gross
 #                         slip far above δ_t every point slides nearly alike, the linearisation is nearly exact
 #                         (McColl 185 N: 1e-5 without the correction) and the correction would cost 1.5× the time
-RESOLVED_CORRECTIONS = 3  # ... for the resolved stroke, where the linear operator (a bound, the same at every
+RESOLVED_CORRECTIONS = 3  # ... at most, for the resolved stroke, where the linear operator (a bound, the same at every
 #                           position) is further from each position's real wear: each pass cuts the step's bias
 #                           about 5× (McColl 185 N 2D at 1 000 cycles, BDF2 against the run cycle by cycle: +1.9 %,
-#                           +0.26 %, +0.025 % after 0, 1, 3; estimate 0.031 %: scripts/results/resolved_stepping.txt)
+#                           +0.26 %, +0.025 % after 0, 1, 3 from no correction; scripts/results/resolved_stepping.txt)
+CORRECTION_SHARE = 0.01  # ... but a resolved step starts from the last step's corrections and stops correcting once a
+#                         pass would move the deepest element's wear by less than this share of model.accuracy of
+#                         its depth: 1.3 passes a step instead of 4, and depth, width and the moving body's depth within
+#                         0.05 %, 0.3 %, 0.02 % of the explicit run (McColl 185 N 2D, 18 000 cycles, as every stepping
+#                         scheme's width there: scripts/results/bench_resolved.txt, 2026-11-26 third round)
+STOPPED_BIAS = 4  # ... and a step stopped so counts this many times that share in its error estimate: the pass's
+#                  defect (the mid-stroke increment's, at the deepest element) understates what stopping leaves, which
+#                  summed to 0.13 % at 1 000 cycles against the run cycle by cycle where the defects said 0.03 % and
+#                  the shares 0.04 %; with 4× the estimate holds at jumping.tolerance 0.003, 0.01 and 0.03 (McColl
+#                  185 N 2D, 427 elements: scripts/results/bench_resolved.txt, 2026-11-26 third round)
+RESOLVED_PASSES = 2  # the cost estimate's passes per resolved implicit step (1.3-1.4 measured, as above, rounded up)
 FATIGUE_SIDE_INCREMENTS = 1  # each elastic side of a fatigue state's cycle (not recorded): the flat's stresses
 #                              over the side move between its ends (the damage with 1, 2 and 12 alike to 1e-11 at
 #                              4, 10 and 25 µm on cases/ti_fretting_fatigue.yaml)
@@ -84,6 +95,7 @@ class CoulombCycle:
     gap_model: str = "mid_stroke"  # at mid-stroke: how the flat's wear enters the mid-stroke gap
     increments: int = 9  # per half-stroke; odd, so that one is centred on mid-stroke
     volume_factor: float = 1.0  # the line length in 2D: grid volumes and forces → totals
+    accuracy: float = 0.01  # model.accuracy (a resolved implicit step corrects its gap down to a share of it)
     tolerance: float = 1e-10  # the tangential solver's
     name: str = "coulomb"
     linear: bool = False
@@ -99,7 +111,8 @@ class CoulombCycle:
         return cls(grid=spec.grid, compliance=spec.compliance, tangential=spec.tangential, stroke=block.stroke,
                    load=spec.load, total_load=block.normal_load, friction_coefficient=block.friction_coefficient,
                    k_moving=k_m, k_stationary=k_s, law=spec.law, rigid=rigid, resolved=spec.resolved,
-                   gap_model=spec.gap_model, increments=spec.increments, volume_factor=spec.volume_factor)
+                   gap_model=spec.gap_model, increments=spec.increments, volume_factor=spec.volume_factor,
+                   accuracy=spec.accuracy)
 
     @property
     def kernel(self) -> str:
@@ -122,7 +135,7 @@ class CoulombCycle:
         return self._w_unit
 
     def passes(self, implicit: bool) -> int:  # (mid-stroke's one correction is in the cost's calibration)
-        return 1 + RESOLVED_CORRECTIONS if implicit and self.resolved else 1
+        return RESOLVED_PASSES if implicit and self.resolved else 1
 
     def describe(self) -> str:
         return (f"{'uniform' if self.rigid else 'coulomb'} slip, stroke {'resolved' if self.resolved else 'mid-stroke'}, "
@@ -159,9 +172,12 @@ class CoulombCycle:
 
     def solve(self, wear_moving, wear_stationary, normal, guess, step: float = 0.0, memory=None,
               cycle: int = 0, detail: bool = True) -> Cycle:
-        """One cycle; an implicit step's (``step`` > 0) corrected CORRECTIONS times for its linearisation."""
+        """One cycle; an implicit step's (``step`` > 0) corrected for its linearisation: CORRECTIONS times at
+        mid-stroke, as :func:`_resolved_step` says for the resolved stroke."""
+        if self.resolved and step:
+            return _resolved_step(self, wear_moving, wear_stationary, normal, guess, step, memory, cycle, detail)
         uneven = float((memory or {}).get("slip_spread", 1.0)) > SPREAD_TO_CORRECT
-        passes = 1 + (0 if not step else RESOLVED_CORRECTIONS if self.resolved else CORRECTIONS if uneven else 0)
+        passes = 1 + (CORRECTIONS if step and uneven else 0)
         cyc = None
         for k in range(passes):
             cyc = self._solve(wear_moving, wear_stationary, normal, guess if cyc is None else cyc.pressure, step,
@@ -198,7 +214,7 @@ class CoulombCycle:
         end = max(k for k in range(first, len(path)) if path[k][1] > path[k][0])
         p_prev, ds_prev, du_prev = guess, None, None
         visits = []  # an implicit resolved step's (pressure, travel) at each increment, for its mismatch
-        states = [] if detail and not corrected else None  # the tractions round the loop (fretting fatigue)
+        states = [] if detail else None  # the tractions round the loop (fretting fatigue; any pass may be returned)
         for k, (u0, u1, counted) in enumerate(path):
             if k == first:
                 tally.loop(u0, q)
@@ -228,7 +244,7 @@ class CoulombCycle:
                 q_high, p_high = q_new, p
             s, q = s + ds, q_new
             p_prev, ds_prev, du_prev = p, ds, du
-        if self.resolved and detail is True and not self.rigid and not corrected:  # (a corrected pass: not returned)
+        if self.resolved and detail is True and not self.rigid:
             tally.loop_u, tally.loop_q = turning_loop(self.stroke, fine, self._tangential, self._elastic_side,
                                                       (q_low, p_low), (q_high, p_high), tally.area)
         defect, mismatch = 0.0, None
@@ -318,7 +334,6 @@ class CoulombCycle:
         ds[rows, cols] = np.where(on[rows, cols], res.slip, ds[rows, cols])  # in contact: the solver's, 0 where stuck
         return q_new, ds, stuck, res.iterations
 
-
 class _Tally:
     """What a cycle's increments add up to: each body's wear and slip, the flat's pressure over the travel, the
     shear's amplitude, the energy, the invariant's work and the loop, and the solvers' iterations."""
@@ -377,6 +392,37 @@ def _response(compliance, step: float, w_lin, mismatch: np.ndarray) -> np.ndarra
     c_hat = conv.hat if conv is not None else compliance.hat
     w_hat = step * w_lin.hat
     return w_lin.backward(w_lin.forward(mismatch) * (w_hat / (c_hat + w_hat)))
+
+
+def _resolved_step(member: CoulombCycle, wear_moving, wear_stationary, normal, guess, step: float, memory,
+                   cycle: int, detail: bool) -> Cycle:
+    """A resolved implicit step: its increments' gaps corrected for the wear the cycle really found, starting
+    from the last step's corrections scaled to this step (the mismatch grows with the step and changes slowly
+    with the worn surface), and corrected again only while a pass would still move the deepest element's wear
+    by more than CORRECTION_SHARE of model.accuracy of its depth (at most RESOLVED_CORRECTIONS times).  Stopped
+    early, the step's ``bias`` (its estimate's share) is STOPPED_BIAS times that bound."""
+    memory = memory or {}
+    correction = _reused(memory, step, 2 * member.increments + 1)
+    limit = CORRECTION_SHARE * member.accuracy * float(np.max(wear_moving + wear_stationary))
+    cyc = None
+    for k in range(1 + RESOLVED_CORRECTIONS):
+        cyc = member._solve(wear_moving, wear_stationary, normal, guess if cyc is None else cyc.pressure, step,
+                            memory, cycle, detail, correction=correction, corrected=True)
+        if cyc.defect <= limit:
+            cyc.bias = STOPPED_BIAS * limit
+            break
+        correction = cyc.mismatch
+    cyc.memory.update(mismatches=np.stack(cyc.mismatch), mismatch_step=step)
+    return cyc
+
+
+def _reused(memory: dict, step: float, count: int):
+    """The last implicit step's per-increment mismatches scaled to ``step`` (None: none kept, or for another
+    path)."""
+    last, last_step = memory.get("mismatches"), memory.get("mismatch_step")
+    if last is None or last_step is None or len(last) != count or not float(last_step) > 0:
+        return None
+    return list(np.asarray(last) * (step / float(last_step)))
 
 
 def _mismatches(visits: list, tally: _Tally, step: float, w_lin, dx: float, kernel: str) -> list:

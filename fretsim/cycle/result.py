@@ -46,6 +46,8 @@ class Cycle:
     # a detailed cycle (a recorded or fatigue state): the moving body's pressure, shear traction (MPa) and each
     # point's travel over the flat (mm) at the loop's start and the end of each increment, arrays (state, ny, nx)
     tractions: Optional[tuple] = None
+    bias: float = 0.0  # implicit steps: what the step's corrections, stopped early, may leave there (mm): counted in
+    #                    the error estimate, not in the step's control (the corrections' own tolerance holds it)
 
 
 @dataclass(frozen=True)
@@ -65,6 +67,7 @@ class CycleSpec:
     resolved: bool  # the normal contact solved at each increment of the stroke (model.stroke resolved)
     increments: int  # per half-stroke
     volume_factor: float  # the line length in 2D: grid volumes and forces → totals
+    accuracy: float = 0.01  # model.accuracy: what an implicit step's corrections need not resolve below
 
 
 def stick_half_width(stick_row: np.ndarray, x: np.ndarray, dx: float) -> float:

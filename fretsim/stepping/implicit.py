@@ -138,8 +138,8 @@ def _accept(loop, cyc, d: int, partner: Optional[int], base: tuple, g: float, ha
         loop.rejected += 1
         loop.lag = max(loop.lag, e_p / d)
         return None
-    loop.err_abs_m += err_m
-    loop.err_abs_s += err_s
+    loop.err_abs_m += err_m + cyc.bias
+    loop.err_abs_s += err_s + cyc.bias
     loop.lag = e_p / d
     loop.advance(h_m - loop.h_m, h_s - loop.h_s, d, new_phi_w - half * cyc.work - loop.work,
                  new_phi_e - half * rate_e - loop.energy)
