@@ -244,7 +244,7 @@ class CoulombCycle:
                 q_high, p_high = q_new, p
             s, q = s + ds, q_new
             p_prev, ds_prev, du_prev = p, ds, du
-        if self.resolved and detail is True and not self.rigid:
+        if self.resolved and detail is True and not self.rigid and not corrected:  # (a corrected pass draws no loop)
             tally.loop_u, tally.loop_q = turning_loop(self.stroke, fine, self._tangential, self._elastic_side,
                                                       (q_low, p_low), (q_high, p_high), tally.area)
         defect, mismatch = 0.0, None
@@ -257,6 +257,7 @@ class CoulombCycle:
         cyc = tally.cycle(self, p_mid, res_mid, stick_end, defect, mismatch)
         if states:
             cyc.tractions = tuple(np.array(a) for a in zip(*states))
+        cyc.turns = ((q_low, p_low), (q_high, p_high)) if self.resolved else None
         return cyc
 
     def _resolved_increment(self, wear_moving, wear_stationary, normal, q, s, du, p_prev, ds_prev, du_prev, extra,
@@ -412,6 +413,10 @@ def _resolved_step(member: CoulombCycle, wear_moving, wear_stationary, normal, g
             cyc.bias = STOPPED_BIAS * limit
             break
         correction = cyc.mismatch
+    if detail is True and not member.rigid:  # the recorded loop, of the pass returned only (48 ms a 2D draw)
+        u, q = turning_loop(member.stroke, max(LOOP_SIDE_INCREMENTS, member.increments), member._tangential,
+                            member._elastic_side, *cyc.turns, member.grid.area * member.volume_factor)
+        cyc.loop, cyc.force_amplitude = (np.array(u), np.array(q)), float(np.abs(q).max())
     cyc.memory.update(mismatches=np.stack(cyc.mismatch), mismatch_step=step)
     return cyc
 
