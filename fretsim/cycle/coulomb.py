@@ -62,14 +62,18 @@ RESOLVED_CORRECTIONS = 3  # ... at most, for the resolved stroke, where the line
 #                           +0.26 %, +0.025 % after 0, 1, 3 from no correction; scripts/results/resolved_stepping.txt)
 CORRECTION_SHARE = 0.01  # ... but a resolved step starts from the last step's corrections and stops correcting once a
 #                         pass would move the deepest element's wear by less than this share of model.accuracy of
-#                         its depth: 1.3 passes a step instead of 4, and depth, width and the moving body's depth within
-#                         0.05 %, 0.3 %, 0.02 % of the explicit run (McColl 185 N 2D, 18 000 cycles, as every stepping
-#                         scheme's width there: scripts/results/bench_resolved.txt, 2026-11-26 third round)
+#                         its depth: 1.4 passes a step instead of 4 (2.5 in 3D), and depth, width and the moving body's
+#                         depth within 0.02 %, 0.32 %, 0.00 % of the explicit run (the three corrections from scratch:
+#                         +0.02 %, +0.31 %, +0.01 %; McColl 185 N 2D, 18 000 cycles: scripts/results/bench_resolved.txt,
+#                         2026-11-26 third round)
 STOPPED_BIAS = 4  # ... and a step stopped so counts this many times that share in its error estimate: the pass's
 #                  defect (the mid-stroke increment's, at the deepest element) understates what stopping leaves, which
 #                  summed to 0.13 % at 1 000 cycles against the run cycle by cycle where the defects said 0.03 % and
 #                  the shares 0.04 %; with 4× the estimate holds at jumping.tolerance 0.003, 0.01 and 0.03 (McColl
 #                  185 N 2D, 427 elements: scripts/results/bench_resolved.txt, 2026-11-26 third round)
+BIAS_FLOOR = 1e-4  # ... of the depth at least, whatever model.accuracy: what stopping leaves does not shrink with the
+#                  bound below it (model.accuracy 0.25 %: +0.135 % at 1 000 cycles, as at 1 %, estimated 0.18 % with
+#                  the floor, 0.07 % without; reused corrections corrected three times every step: +0.04 %)
 RESOLVED_PASSES = 2  # the cost estimate's passes per resolved implicit step: McColl 185 N took 1.4 in 2D (119 passes
 #                      for 86 steps tried), 2.5 in 3D (209 for 82 accepted)
 FATIGUE_SIDE_INCREMENTS = 1  # each elastic side of a fatigue state's cycle (not recorded): the flat's stresses
@@ -405,13 +409,14 @@ def _resolved_step(member: CoulombCycle, wear_moving, wear_stationary, normal, g
     early, the step's ``bias`` (its estimate's share) is STOPPED_BIAS times that bound."""
     memory = memory or {}
     correction = _reused(memory, step, 2 * member.increments + 1)
-    limit = CORRECTION_SHARE * member.accuracy * float(np.max(wear_moving + wear_stationary))
+    depth = float(np.max(wear_moving + wear_stationary))
+    limit = CORRECTION_SHARE * member.accuracy * depth
     cyc = None
     for k in range(1 + RESOLVED_CORRECTIONS):
         cyc = member._solve(wear_moving, wear_stationary, normal, guess if cyc is None else cyc.pressure, step,
                             memory, cycle, detail, correction=correction, corrected=True)
         if cyc.defect <= limit:
-            cyc.bias = STOPPED_BIAS * limit
+            cyc.bias = STOPPED_BIAS * max(limit, BIAS_FLOOR * depth)
             break
         correction = cyc.mismatch
     if detail is True and not member.rigid:  # the recorded loop, of the pass returned only (48 ms a 2D draw)
