@@ -38,7 +38,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Optional
 
 import numpy as np
 
@@ -161,17 +160,6 @@ class CoulombCycle:
         return self.k_moving * work, self.k_stationary * work
 
     # -- one cycle --------------------------------------------------------------------------------------------
-    def path(self, increments: Optional[int] = None) -> list[tuple[float, float, bool]]:
-        """(U at the start, U at the end, counted) of every increment: 0 → −δ in one (uncounted: it sets up the
-        traction's history, and loading monotonically from rest it is exact at a fixed pressure; cut as the loop it
-        was a fifth of a resolved cycle's solves for 0.02 % of McColl 185 N's depth), then the loop −δ → +δ → −δ."""
-        d, n = self.stroke, increments or self.increments
-        nq = 1
-        quarter = [(-d * k / nq, -d * (k + 1) / nq, False) for k in range(nq)]
-        up = [(-d + 2 * d * k / n, -d + 2 * d * (k + 1) / n, True) for k in range(n)]
-        down = [(d - 2 * d * k / n, d - 2 * d * (k + 1) / n, True) for k in range(n)]
-        return quarter + up + down
-
     def _elastic_side(self, pressure: np.ndarray) -> float:
         return 0.0 if self.rigid else elastic_side(self.tangential, self.friction_coefficient, pressure)
 
@@ -212,7 +200,7 @@ class CoulombCycle:
         if detail == TRACTIONS:  # a fatigue state, not recorded: the tractions need the sides' ends, not their shape
             fine = FATIGUE_SIDE_INCREMENTS
         path = (loop_path(self.stroke, self._elastic_side(fixed[0]), fine) if detail and not self.resolved
-                and not self.rigid else self.path(n))
+                and not self.rigid else increment_path(self.stroke, n))
         first = next(k for k, step in enumerate(path) if step[2])  # the loop's first increment (after the quarter)
         # the increment over U = 0 going up (centred on it for the resolved stroke's odd count); the up-stroke's end
         mid = next(k for k in range(first, len(path)) if path[k][0] < 0.0 <= path[k][1])
@@ -389,6 +377,18 @@ class _Tally:
             iterations=self.iterations, loop=(np.array(self.loop_u), np.array(self.loop_q)),
             memory={"slip_lin": max(s_max, 1e-300), "slip_spread": 1.0 - s_mean / s_max if s_max > 0 else 1.0},
             defect=defect, mismatch=mismatch, stick=stick_end if stick_end.any() else None)
+
+
+def increment_path(stroke: float, n: int) -> list[tuple[float, float, bool]]:
+    """(U at the start, U at the end, counted) of every increment: 0 → −δ in one (uncounted: it sets up the
+    traction's history, and loading monotonically from rest it is exact at a fixed pressure; cut as the loop it
+    was a fifth of a resolved cycle's solves for 0.02 % of McColl 185 N's depth), then the loop −δ → +δ → −δ."""
+    d = stroke
+    nq = 1
+    quarter = [(-d * k / nq, -d * (k + 1) / nq, False) for k in range(nq)]
+    up = [(-d + 2 * d * k / n, -d + 2 * d * (k + 1) / n, True) for k in range(n)]
+    down = [(d - 2 * d * k / n, d - 2 * d * (k + 1) / n, True) for k in range(n)]
+    return quarter + up + down
 
 
 def _response(compliance, step: float, w_lin, mismatch: np.ndarray) -> np.ndarray:
