@@ -461,8 +461,10 @@ def _fatigue(s: dict, c) -> str:
     if c.stationary.fatigue is None or "damage_mode" not in s:
         return ""
     n, err = s["cycles_to_crack_initiation"], s.get("estimated_error_cycles_to_crack", float("nan"))
-    where = (f"SWT peak {s['swt_max_MPa']:.3g} MPa at x = {s['swt_location_x_mm'] * 1e3:.4g} µm, "
-             f"{s['swt_depth_um']:.3g} µm deep")
+    crit = c.stationary.fatigue.critical_distance
+    where = (f"the largest point SWT {s['swt_max_MPa']:.3g} MPa at x = {s['swt_location_x_mm'] * 1e3:.4g} µm, "
+             f"{s['swt_depth_um']:.3g} µm deep" + (f"; the damage counts its mean over the {crit * 1e3:.3g} µm below "
+                                                   f"each surface point" if crit else ""))
     if math.isfinite(n):
         text = (f" Fretting fatigue: a crack starts at cycle {n:,.0f}" + (f" (± {err:.1e} relative)" if
                                                                           math.isfinite(err) else "")

@@ -1036,10 +1036,10 @@ def fatigue_life_sweep(table: SweepTable):
         return None
     fig, ax = plt.subplots(figsize=(10.5, 4.6))
 
-    def worn(row) -> bool:  # a point that sets every wear coefficient it names to 0 runs without wear
-        given = [_AS_WRITTEN.match(str(v)) or re.match(r"^\s*([-+0-9.eE]+)\s*$", str(v)) for k, v in row.items()
-                 if k.endswith("wear_coefficient")]
-        return not given or any(m is None or float(m.group(1)) != 0 for m in given)
+    def worn(row) -> bool:  # without wear: a point that sets both bodies' wear coefficients to 0
+        values = [row.get(f"materials.{body}.wear_coefficient") for body in ("moving", "stationary")]
+        given = [_AS_WRITTEN.match(str(v)) or re.match(r"^\s*([-+0-9.eE]+)\s*$", str(v)) for v in values if v]
+        return not (len(given) == 2 and all(m is not None and float(m.group(1)) == 0 for m in given))
 
     for label, colour, pick in (("with wear", "C0", True), ("without wear (k = 0)", "C3", False)):
         group = sorted((r for r in rows if worn(r) == pick), key=lambda r: _in_unit(r.get("loading.stroke"), _TO_UM))

@@ -258,10 +258,12 @@ class _Loop:
         if verdict == "reached":
             step.is_snapshot = True  # the state at the limit is what the engineer looks at
             step.limit = self.reached = self.landing.reached()
-        if self.miner is not None and self._fatigue(step) and verdict != "reached":
-            verdict = "reached"  # limits.crack_initiation: the run ends at the state where the damage reached 1
-            step.is_snapshot = True
-            step.limit = self.reached = ("crack_initiation", self.miner.crack[0], self.n - self.miner.crack[0], 1.0)
+        if self.miner is not None and self._fatigue(step):
+            crack = self.miner.crack[0]
+            if verdict != "reached" or crack < step.limit[1]:  # (the first crossing names the limit reached)
+                verdict = "reached"  # limits.crack_initiation: the run ends at the state where the damage reached 1
+                step.is_snapshot = True
+                step.limit = self.reached = ("crack_initiation", crack, self.n - crack, 1.0)
         step.state = checkpoint.state(self)
         self.last_state = step.state
         for obs in self.observers:
@@ -278,9 +280,16 @@ class _Loop:
         step at or past each (the states are not stops: the stepping takes its own steps, each detailed as due)."""
         if self.miner is None:
             return False
-        if self.miner.damage is None:
+        if self.miner.damage is None or cycle in self.s.loading.boundaries:  # (a block's end: the rate jumps there)
             return True
         return cycle >= next((n for n in self.s.fatigue.states if n > self.miner.cycle), math.inf)
+
+    def fatigue_restart(self, cyc: Cycle) -> None:
+        """A block's start: the new block's cycle at the same wear restarts Miner's sums (loop.blocks)."""
+        if self.miner is not None and cyc.tractions is not None:
+            s = self.s
+            self.miner.restart(self.n, evaluate(s.fatigue, s.grid.x, s.grid.dx, s.fatigue.curve.youngs_modulus, cyc,
+                                                full=False))
 
     def _fatigue(self, step: Step) -> bool:
         """The flat's fatigue at a detailed state (or at a wear limit's, detailed now) added to Miner's sum; True
@@ -295,11 +304,11 @@ class _Loop:
         step.fatigue = evaluate(s.fatigue, s.grid.x, s.grid.dx, s.fatigue.curve.youngs_modulus, cyc,
                                 full=step.is_snapshot)
         had = self.miner.crack is not None
-        self.miner.add(self.n, step.fatigue)
+        self.miner.add(self.n, step.fatigue, s.grid.x)
         stop = s.fatigue.crack_limit and not had and self.miner.crack is not None
         if stop and not step.fatigue.full:  # the run ends here: this state is recorded, with its fields in full
             step.fatigue = evaluate(s.fatigue, s.grid.x, s.grid.dx, s.fatigue.curve.youngs_modulus, cyc)
-            self.miner.peak(step.fatigue)
+            self.miner.peak(step.fatigue)  # (its largest shear: the state's every layer)
         return stop
 
     def restored_cycle(self) -> Cycle:

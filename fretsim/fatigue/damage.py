@@ -71,7 +71,7 @@ class FatigueState:
     swt_x: float  # mm
     swt_depth: float  # mm
     ruiz_max: float  # MPa²·mm
-    stresses: Optional[tuple] = None  # (σx, σz, τxz) amplitude fields (depth, x): the largest |value| over the cycle
+    stresses: Optional[tuple] = None  # σx, σz, τxz each as its largest and smallest over the cycle, fields (depth, x)
     full: bool = True  # a recorded state: every layer, and the figures above (else the damage's layers only)
 
 
@@ -81,7 +81,7 @@ def evaluate(spec: FatigueSpec, x: np.ndarray, dx: float, youngs: float, cyc, fu
     otherwise (a fatigue state between them, for the damage only) with a critical distance only the layers the
     line method averages over are computed."""
     p, q, travel = (np.asarray(a)[:, 0, :] for a in cyc.tractions)
-    keep = _thinned(len(p), slides(p, travel, dx))
+    keep = _thinned(q, slides(p, travel, dx))
     p, q, travel = p[keep], q[keep], travel[keep]
     p_flat, q_flat = history.on_flat(p, travel, x, dx), history.on_flat(q, travel, x, dx)
     cols = history.window(p_flat)
@@ -90,24 +90,24 @@ def evaluate(spec: FatigueSpec, x: np.ndarray, dx: float, youngs: float, cyc, fu
     layers = nz if full or spec.critical_distance is None else min(nz, int(np.searchsorted(z, spec.critical_distance)) + 1)
     swt, angle = np.zeros((nz, nx)), np.zeros((nz, nx))
     if cols.stop <= cols.start:
-        return _state(spec, z, x, swt, angle, None, 0.0, 0.0, 0.0, 0.0, full)
+        return _state(spec, z, x, swt, angle, None, 0.0 if full else math.nan, 0.0, 0.0, 0.0, full)
     st = history.stresses(p_flat[:, cols], q_flat[:, cols], dx, z[:layers])
     plane = swt_search((st.sxx, st.szz, st.sxz), youngs, spec.poisson, slides(p, travel, dx),
                        skip=0.0 if full else SKIP)
     swt[:layers, cols], angle[:layers, cols] = plane.swt, plane.angle
-    if not full:
-        return _state(spec, z, x, swt, angle, None, 0.0, 0.0, 0.0, 0.0, full)
-    shear = np.hypot(0.5 * (st.sxx - st.szz), st.sxz).max(axis=0)  # (depth, x) over the cycle
-    k = np.unravel_index(np.argmax(shear), shear.shape)
-    tension = float(st.sxx[:, 0, :].max())
+    tension = float(st.sxx[:, 0, :].max())  # (the surface layer: computed at every state)
     slip_amplitude = 0.25 * np.asarray(cyc.slip_stationary)[0, cols]  # mm: a quarter of the cycle's slip
     ruiz = np.maximum(st.sxx[:, 0, :].max(axis=0), 0.0) * np.abs(q_flat[:, cols]).max(axis=0) * slip_amplitude
-    amplitudes = None
-    if spec.keep_stresses:
-        amplitudes = tuple(_widen(np.take_along_axis(a, np.abs(a).argmax(axis=0)[None], 0)[0], cols, nx)
-                           for a in (st.sxx, st.szz, st.sxz))
-    return _state(spec, z, x, swt, angle, amplitudes, float(shear[k]), float(z[k[0]]), tension,
-                  float(ruiz.max(initial=0.0)), full)
+    shear_max, shear_depth, extremes = math.nan, math.nan, None
+    if full:  # every layer: the largest shear (often deeper than the critical distance) and the stresses' range
+        shear = np.hypot(0.5 * (st.sxx - st.szz), st.sxz).max(axis=0)  # (depth, x) over the cycle
+        k = np.unravel_index(np.argmax(shear), shear.shape)
+        shear_max, shear_depth = float(shear[k]), float(z[k[0]])
+        if spec.keep_stresses:
+            extremes = tuple(_widen(pick(a, axis=0), cols, nx) for a in (st.sxx, st.szz, st.sxz)
+                             for pick in (np.max, np.min))
+    return _state(spec, z, x, swt, angle, extremes, shear_max, shear_depth, tension, float(ruiz.max(initial=0.0)),
+                  full)
 
 
 SKIP = 0.01  # between recorded states, points whose SWT bound is below this share of the field's largest are not
@@ -137,11 +137,18 @@ TIME_STATES = 12  # the cycle's states the stresses are computed at, at most, be
 #                  state's elastic sides are cut in 12 for the loop's shape, the stresses need their ends
 
 
-def _thinned(states: int, slid: dict) -> list:
-    """The states kept: the first and last, every sliding one and the one it slid from, and evenly among the rest
-    up to TIME_STATES."""
+def _thinned(shear: np.ndarray, slid: dict) -> list:
+    """The states kept: the first and last, the loop's turning points (where the tangential force Σq is largest,
+    smallest, or turns back: a resolved cycle's up-stroke ends at an odd index, which an even stride dropped, and
+    its life came out 37 % long), every sliding one and the one it slid from, and evenly among the rest up to
+    TIME_STATES."""
+    states = len(shear)
+    force = shear.reshape(states, -1).sum(axis=1)
+    step = np.diff(force)
+    turns = {k for k in range(1, states - 1) if step[k - 1] * step[k] < 0}
     stride = max(1, int(np.ceil(states / TIME_STATES)))
-    keep = {0, states - 1} | set(slid) | {k - 1 for k in slid} | set(range(0, states, stride))
+    keep = ({0, states - 1, int(np.argmax(force)), int(np.argmin(force))} | turns | set(slid)
+            | {k - 1 for k in slid} | set(range(0, states, stride)))
     return sorted(keep)
 
 
@@ -181,7 +188,7 @@ class Miner:
     damage: Optional[np.ndarray] = None
     rate: Optional[np.ndarray] = None  # 1/N_i at the last state
     cycle: float = 0.0  # of the last state
-    crack: Optional[tuple] = None  # (cycle, damage point index (depth, x)) where D first reached 1
+    crack: Optional[tuple] = None  # (cycle, x in mm) where D first reached 1
     peaks: dict = field(default_factory=dict)  # the largest figures over the states (and where)
     # the same sum over every other state (the 1st, 3rd, …): how far the states' spacing moves the answer
     half: Optional[np.ndarray] = None
@@ -190,8 +197,10 @@ class Miner:
     half_crack: float = math.nan
     count: int = 0  # states added
 
-    def add(self, n: int, state: FatigueState) -> None:
-        rate = np.where(np.isfinite(state.life), 1.0 / np.where(np.isfinite(state.life), state.life, 1.0), 0.0)
+    def add(self, n: int, state: FatigueState, x: Optional[np.ndarray] = None) -> None:
+        """Count the damage from the last state to this one at cycle ``n``; ``x`` the grid's element centres (mm),
+        where a crack is said to start (kept in mm: a later widening of the grid moves the columns, not the place)."""
+        rate = _rate(state)
         if self.damage is None:
             self.damage, self.half, self.half_rate, self.half_cycle = np.zeros_like(rate), np.zeros_like(rate), rate, n
         else:
@@ -199,20 +208,35 @@ class Miner:
             before = self.damage
             self.damage = before + 0.5 * (self.rate + rate) * span
             if self.crack is None and (self.damage >= 1.0).any():
-                self.crack = _crossing(before, self.rate, rate, span, self.cycle)
+                cycle, (_, column) = _crossing(before, self.rate, rate, span, self.cycle)
+                self.crack = (cycle, float(x[column]) if x is not None else float(column))
             if self.count % 2 == 0:
                 self._add_half(n, rate)
         self.rate, self.cycle = rate, float(n)
         self.count += 1
-        if state.full:
-            self.peak(state)
+        self.peak(state)
+
+    def restart(self, n: int, state: FatigueState) -> None:
+        """A load history's block starts at cycle ``n``: the damage rate jumps there, so neither sum's trapezoid
+        may bridge it.  The state the last block ended at (added before) closes both sums at ``n``; the new block's
+        ``state`` at the same cycle starts them again."""
+        if self.damage is None:
+            self.add(n, state)
+            return
+        if self.half_cycle < n:
+            self._add_half(n, self.rate)
+        self.rate = self.half_rate = _rate(state)
+        self.cycle = self.half_cycle = float(n)
+        self.count += self.count % 2  # (the next state is in both sums)
 
     def peak(self, state: FatigueState) -> None:
-        """The summary's figures: the largest over the recorded states (whose fields are written)."""
+        """The summary's figures: the largest over the fatigue states (a load history's short heavy block may fall
+        between recorded states); the largest shear, which can lie below the layers computed between recorded
+        states, over the recorded states."""
         for key, value, where in (("max_shear", state.max_shear, state.max_shear_depth),
                                   ("max_tension", state.max_tension, 0.0), ("ruiz_max", state.ruiz_max, 0.0),
                                   ("swt_max", state.swt_max, (state.swt_x, state.swt_depth))):
-            if key not in self.peaks or value > self.peaks[key][0]:
+            if math.isfinite(value) and (key not in self.peaks or value > self.peaks[key][0]):
                 self.peaks[key] = (value, where)
 
     def _add_half(self, n: float, rate: np.ndarray) -> None:
@@ -253,7 +277,7 @@ class Miner:
         if math.isfinite(self.half_crack):
             out["fatigue_half_crack"] = float(self.half_crack)
         if self.crack is not None:
-            out["fatigue_crack"] = np.array([self.crack[0], *self.crack[1]], dtype=float)
+            out["fatigue_crack"] = np.array(self.crack, dtype=float)
         for key, (value, where) in self.peaks.items():
             out[f"fatigue_peak_{key}"] = np.array([value, *np.atleast_1d(where)], dtype=float)
         return out
@@ -265,7 +289,7 @@ class Miner:
         crack = None
         if "fatigue_crack" in st:
             c = np.asarray(st["fatigue_crack"], dtype=float)
-            crack = (float(c[0]), tuple(int(v) for v in c[1:]))
+            crack = (float(c[0]), float(c[1]))
         peaks = {}
         for key in ("max_shear", "max_tension", "ruiz_max", "swt_max"):
             if f"fatigue_peak_{key}" in st:
@@ -278,6 +302,12 @@ class Miner:
                    float(st.get("fatigue_half_crack", math.nan)), int(st["fatigue_count"]))
 
 
+def _rate(state: FatigueState) -> np.ndarray:
+    """The damage per cycle 1/N_i at each damage point (0 where the life is infinite)."""
+    finite = np.isfinite(state.life)
+    return np.where(finite, 1.0 / np.where(finite, state.life, 1.0), 0.0)
+
+
 def _crossing(before: np.ndarray, r0: np.ndarray, r1: np.ndarray, span: float, start: float) -> tuple:
     """The first cycle at which D(t) = D₀ + r₀t + (r₁ − r₀)t²/(2ΔN) reaches 1 over the points that passed it in
     this interval, and that point."""
@@ -285,8 +315,8 @@ def _crossing(before: np.ndarray, r0: np.ndarray, r1: np.ndarray, span: float, s
     b, c = r0.ravel()[passed], before.ravel()[passed] - 1.0
     a = (r1.ravel()[passed] - r0.ravel()[passed]) / (2.0 * span)
     with np.errstate(divide="ignore", invalid="ignore"):
-        quad = (-b + np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0))) / (2.0 * a)
-        t = np.where(np.abs(a) * span < 1e-12 * np.maximum(np.abs(b), 1e-300), -c / b, quad)
+        # the root of a·t² + b·t + c (c < 0) in the form that does not cancel when a is small (b ≥ 0: a rate)
+        t = -2.0 * c / (b + np.sqrt(np.maximum(b * b - 4.0 * a * c, 0.0)))
     t = np.clip(np.nan_to_num(t, nan=span), 0.0, span)
     k = int(np.argmin(t))
     return start + float(t[k]), tuple(int(i) for i in np.unravel_index(passed[k], before.shape))
@@ -318,7 +348,7 @@ def summary(spec: FatigueSpec, state: dict, x: np.ndarray, limit: Optional[tuple
         "swt_depth_um": swt_z * 1e3,
         "ruiz_max": peak("ruiz_max")[0],
         "cycles_to_crack_initiation": crack,
-        "crack_location_x_mm": float(x[miner.crack[1][-1]]) if miner.crack is not None else nan,
+        "crack_location_x_mm": miner.crack[1] if miner.crack is not None else nan,
         "fatigue_damage": float(miner.damage.max()) if miner.damage is not None else nan,
         "damage_mode": damage_mode(crack, wear_limit),
         "fatigue_states_error": miner.states_error(),

@@ -28,6 +28,7 @@ def enter_block(loop) -> None:
     # tube contact (7247 elements, load 15 N → 5 N), where the cold start converges
     cyc = loop.cycle_at(loop.n, None)
     loop.cyc = cyc
+    loop.fatigue_restart(cyc)  # (the fatigue damage's rate jumps with the block)
     loop.p, loop.r_m, loop.r_s, loop.memory = cyc.pressure, cyc.rate_moving, cyc.rate_stationary, cyc.memory
     loop.rate_work = cyc.work
     loop.rate_energy = loop.energy_rate(cyc)

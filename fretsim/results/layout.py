@@ -72,9 +72,9 @@ SUBSURFACE = {
                         lambda f: np.degrees(f.angle)),
 }
 STRESSES = {
-    f"stress_{c}": ("MPa", f"the stationary body's stress σ_{c} below its surface: its value of largest magnitude "
-                           f"over the cycle (signed)", lambda f, i=i: f.stresses[i])
-    for i, c in enumerate(("xx", "zz", "xz"))}
+    f"stress_{c}_{end}": ("MPa", f"the stationary body's stress σ_{c} below its surface: its {end}imum over the cycle",
+                          lambda f, i=2 * i + j: f.stresses[i])
+    for i, c in enumerate(("xx", "zz", "xz")) for j, end in enumerate(("max", "min"))}
 FIELDS_V12 = [k for k in FIELDS if not k.startswith(("slip_distance", "shear"))]
 NAN_FIELDS = {"shear_traction"}  # the uniform model without a friction coefficient does not know it
 SUMMARY_UNITS = {key: figure.unit for key, figure in SUMMARY.items()}
