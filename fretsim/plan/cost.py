@@ -55,7 +55,7 @@ def estimate_cost(setup) -> tuple[int, float]:
         t = time.perf_counter()
         solve(op, gap, setup.cycle.load, method=setup.method, tol=setup.tolerance)
         cold = time.perf_counter() - t
-        return solves, _seconds(setup, solves, cold)
+        return solves, _seconds(setup, solves, cold) + _fatigue_seconds(setup, op, gap, solves)
 
     def normal(seen, guess, extra=None, load=None, cycle=0):
         res = solve(op if extra is None else add(op, extra), gap + seen, load, method=setup.method, p0=guess,
@@ -66,4 +66,34 @@ def estimate_cost(setup) -> tuple[int, float]:
     t = time.perf_counter()
     setup.cycle.solve(zero, zero, normal, None)
     passes = setup.cycle.passes(setup.stepper.implicit)
-    return solves, _seconds(setup, solves, time.perf_counter() - t) * passes
+    return solves, _seconds(setup, solves, time.perf_counter() - t) * passes + _fatigue_seconds(setup, op, gap, solves)
+
+
+def _fatigue_seconds(setup, op, gap, solves: int) -> float:
+    """Fretting fatigue's share: one fatigue state timed on the unworn contact (its cycle detailed for the
+    tractions, the flat's stresses and the plane search), times the states the run will evaluate — the fatigue
+    states up to its cycles, at most one a step, and the recorded states in full.  The worn contact is wider than
+    the unworn: a low estimate, as the solves' own."""
+    if setup.fatigue is None:
+        return 0.0
+    from fretsim.cycle.result import TRACTIONS
+    from fretsim.fatigue.damage import evaluate
+
+    def normal(seen, guess, extra=None, load=None, cycle=0):
+        res = solve(op if extra is None else add(op, extra), gap + seen, load, method=setup.method, p0=guess,
+                    tol=setup.tolerance)
+        return res.pressure, res
+
+    zero = np.zeros(setup.grid.shape)
+    t = time.perf_counter()
+    cyc = setup.cycle.solve(zero, zero, normal, None, detail=TRACTIONS)
+    if cyc.tractions is None:
+        return 0.0
+    cycle_s = time.perf_counter() - t
+    args = (setup.fatigue, setup.grid.x, setup.grid.dx, setup.fatigue.curve.youngs_modulus, cyc)
+    evaluate(*args, full=False)  # (the first pays scipy's imports and the depths' kernels, once a run)
+    t = time.perf_counter()
+    evaluate(*args, full=False)
+    one = cycle_s * WARM_SOLVE + time.perf_counter() - t
+    states = sum(1 for n in setup.fatigue.states if n <= setup.cycles)
+    return one * min(states, max(solves, 1)) + 3.0 * one * len(setup.snapshots)  # (a recorded state: every layer)
