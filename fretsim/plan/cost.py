@@ -57,16 +57,21 @@ def estimate_cost(setup) -> tuple[int, float]:
         cold = time.perf_counter() - t
         return solves, _seconds(setup, solves, cold) + _fatigue_seconds(setup, op, gap, solves)
 
-    def normal(seen, guess, extra=None, load=None, cycle=0):
-        res = solve(op if extra is None else add(op, extra), gap + seen, load, method=setup.method, p0=guess,
-                    tol=setup.tolerance)
-        return res.pressure, res
-
+    normal = _normal(setup, op, gap)
     zero = np.zeros(setup.grid.shape)
     t = time.perf_counter()
     setup.cycle.solve(zero, zero, normal, None)
     passes = setup.cycle.passes(setup.stepper.implicit)
     return solves, _seconds(setup, solves, time.perf_counter() - t) * passes + _fatigue_seconds(setup, op, gap, solves)
+
+
+def _normal(setup, op, gap):
+    """The normal contact as a cycle member asks for it, on the unworn gap (cold-started unless guessed)."""
+    def normal(seen, guess, extra=None, load=None, cycle=0):
+        res = solve(op if extra is None else add(op, extra), gap + seen, load, method=setup.method, p0=guess,
+                    tol=setup.tolerance)
+        return res.pressure, res
+    return normal
 
 
 def _fatigue_seconds(setup, op, gap, solves: int) -> float:
@@ -79,14 +84,9 @@ def _fatigue_seconds(setup, op, gap, solves: int) -> float:
     from fretsim.cycle.result import TRACTIONS
     from fretsim.fatigue.damage import evaluate
 
-    def normal(seen, guess, extra=None, load=None, cycle=0):
-        res = solve(op if extra is None else add(op, extra), gap + seen, load, method=setup.method, p0=guess,
-                    tol=setup.tolerance)
-        return res.pressure, res
-
     zero = np.zeros(setup.grid.shape)
     t = time.perf_counter()
-    cyc = setup.cycle.solve(zero, zero, normal, None, detail=TRACTIONS)
+    cyc = setup.cycle.solve(zero, zero, _normal(setup, op, gap), None, detail=TRACTIONS)
     if cyc.tractions is None:
         return 0.0
     cycle_s = time.perf_counter() - t
