@@ -4,7 +4,9 @@
   (closed forms of the strips' line-load integrals);
 * :mod:`.swt` — the Smith–Watson–Topper parameter on the critical plane, its life from the Basquin–Coffin–Manson
   curve, and Ruiz's fretting damage parameter.
-* :mod:`.stresses3d` — the same for the 3D half-space on a grid (rectangles by FFT); :func:`.swt.swt_3d` in 3D.
-
-Pure functions over arrays; nothing here is wired into the loop yet.
+* :mod:`.stresses3d` — the same for the 3D half-space on a grid (rectangles by FFT); :func:`.swt.swt_3d` in 3D
+  (not wired into the loop: a 3D fatigue case is refused);
+* :mod:`.history` — a cycle's tractions laid on the flat and its stresses over the cycle (by FFT);
+* :mod:`.damage` — the fatigue states, each state's SWT field and life, and Miner's sum over the wear history
+  (what the loop, :mod:`fretsim.simulate`, calls).
 """

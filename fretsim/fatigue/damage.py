@@ -81,8 +81,10 @@ def evaluate(spec: FatigueSpec, x: np.ndarray, dx: float, youngs: float, cyc, fu
     otherwise (a fatigue state between them, for the damage only) with a critical distance only the layers the
     line method averages over are computed."""
     p, q, travel = (np.asarray(a)[:, 0, :] for a in cyc.tractions)
-    keep = _thinned(q, slides(p, travel, dx))
+    slid = slides(p, travel, dx)
+    keep = _thinned(q, slid)
     p, q, travel = p[keep], q[keep], travel[keep]
+    slid = {keep.index(k): m for k, m in slid.items()}  # (every sliding state is kept, and the one before it)
     p_flat, q_flat = history.on_flat(p, travel, x, dx), history.on_flat(q, travel, x, dx)
     cols = history.window(p_flat)
     z = spec.depths
@@ -92,7 +94,7 @@ def evaluate(spec: FatigueSpec, x: np.ndarray, dx: float, youngs: float, cyc, fu
     if cols.stop <= cols.start:
         return _state(spec, z, x, swt, angle, None, 0.0 if full else math.nan, 0.0, 0.0, 0.0, full)
     st = history.stresses(p_flat[:, cols], q_flat[:, cols], dx, z[:layers])
-    plane = swt_search((st.sxx, st.szz, st.sxz), youngs, spec.poisson, slides(p, travel, dx),
+    plane = swt_search((st.sxx, st.szz, st.sxz), youngs, spec.poisson, slid,
                        skip=0.0 if full else SKIP)
     swt[:layers, cols], angle[:layers, cols] = plane.swt, plane.angle
     tension = float(st.sxx[:, 0, :].max())  # (the surface layer: computed at every state)
