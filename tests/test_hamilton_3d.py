@@ -117,7 +117,7 @@ def _subsurface_von_mises(mu):
 
 def test_reference_moves_the_largest_von_mises_stress_to_the_surface_near_mu_0_3():
     """Hamilton (1983): as friction rises the yield-critical point leaves the subsurface (0.62 p₀ at 0.48 a under the
-    centre for μ = 0, ν = 0.3) for the trailing edge; for ν = 0.3 the two are equal at μ = 0.31 (found here by
+    centre for μ = 0, ν = 0.3) for the trailing edge; for ν = 0.3 the two are equal at μ = 0.305 (found here by
     brentq; Hamilton's figures put it at about 0.3)."""
     peak, x0, z0 = _subsurface_von_mises(0.0)
     assert peak == pytest.approx(0.620, abs=1e-3) and abs(x0) < 1e-5 and z0 == pytest.approx(0.48, abs=0.01)
