@@ -262,7 +262,9 @@ def _at_points(abc: tuple, slides: dict, rows: np.ndarray, cols: np.ndarray) -> 
         for k, m in slides.items():
             at = np.clip(cols[None, :] + np.sign(m) * np.arange(1, abs(m) + 1)[:, None], 0, nx - 1)
             parts.append(arr[k][rows[None, :], at])
-        out.append(np.concatenate(parts, axis=0))
+        # C order: a fancy index over the states leaves them the fast axis, and the reductions over that short
+        # axis ran 25x slower (55 µs instead of 2 for 3 states x 1400 points)
+        out.append(np.ascontiguousarray(np.concatenate(parts, axis=0)))
     return tuple(out)
 
 
