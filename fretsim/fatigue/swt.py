@@ -171,24 +171,24 @@ def _bound(s_abc, e_abc, slides: dict) -> np.ndarray:
         v = abc[0] + sign * np.hypot(abc[1], abc[2])
         out = v.max(axis=0) if pick is np.maximum else v.min(axis=0)
         for k, m in slides.items():
-            out = pick(out, _sliding(v[k], m, pick))
+            out = pick(out, _sliding(v[k].T, m, pick).T)
         return out
     return (np.maximum(extreme(s_abc, 1, np.maximum), 0.0) * 0.5 *
             (extreme(e_abc, 1, np.maximum) - extreme(e_abc, -1, np.minimum)))
 
 
 def _refine(coarse: np.ndarray, value) -> tuple:
-    """From the 5° pass's values (angle, point): each point's two best planes' neighbourhoods degree by degree,
+    """From the 5° pass's values (point, angle): each point's two best planes' neighbourhoods degree by degree,
     where the 5° value is at least FINE_SHARE of the peak (a fretting cycle's mirror-image planes often tie to
     round-off, and the pass about the wrong one of two near-equal peaks can miss the best by 10 % or more).
     ``value(phi, selection)`` → the SWT at the selected points on their planes φ."""
     step = np.pi / COARSE_ANGLES
-    order = np.argsort(coarse, axis=0)
-    best = np.take_along_axis(coarse, order[-1:], 0)[0]
-    where = order[-1] * step
+    order = np.argsort(coarse, axis=1)  # (each point's angles in a row: the sort reads them contiguous)
+    best = np.take_along_axis(coarse, order[:, -1:], 1)[:, 0]
+    where = order[:, -1] * step
     sel = np.flatnonzero(best >= FINE_SHARE * best.max()) if best.max() > 0 else np.zeros(0, int)
     b, w = best[sel], where[sel]
-    for centre in (order[-1][sel] * step, order[-2][sel] * step):
+    for centre in (order[sel, -1] * step, order[sel, -2] * step):
         for k in range(-FINE_HALF, FINE_HALF + 1):
             if k:
                 phi = np.mod(centre + k * (np.pi / ANGLES), np.pi)
@@ -202,24 +202,31 @@ def _refine(coarse: np.ndarray, value) -> tuple:
 def _value_pts(s_pts: tuple, e_pts: tuple, phi) -> np.ndarray:
     """SWT on the plane(s) φ at points whose whole history (states and windows) is gathered: (history, points)."""
     c2, s2 = np.cos(2.0 * phi), np.sin(2.0 * phi)
-    sn = s_pts[0] + s_pts[1] * c2 + s_pts[2] * s2
-    en = e_pts[0] + e_pts[1] * c2 + e_pts[2] * s2
+    sn, en = _project(s_pts, c2, s2), _project(e_pts, c2, s2)
     return np.maximum(sn.max(axis=0), 0.0) * 0.5 * (en.max(axis=0) - en.min(axis=0))
 
 
+def _project(abc: tuple, c2, s2) -> np.ndarray:
+    """a + b·cos 2φ + c·sin 2φ, summed in that order (in place: two temporaries, not four)."""
+    out = np.multiply(abc[1], c2)
+    out += abc[0]  # (a + b·c2 as b·c2 + a: the same rounding)
+    out += np.multiply(abc[2], s2)
+    return out
+
+
 def _search_field(s_abc, e_abc, slides: dict) -> tuple:
-    """The search over a (state, leading, x) field: the 5° pass over every point's history gathered (the states and
-    each window's positions: one array operation per plane) where the windows are short against the states, else
-    by running filters along x; the second pass at the points that need it, their windows gathered."""
+    """The search over a (state, leading, x) field: the 5° pass over the field plane by plane
+    (:func:`_coarse_field`), or with every point's history gathered (the states and each window's positions: one
+    array operation per plane) where GATHER says; the second pass at the points that need it, their windows
+    gathered."""
     step = np.pi / COARSE_ANGLES
-    if sum(abs(m) for m in slides.values()) <= GATHER * s_abc[0].shape[0]:
-        rows, cols = (a.ravel() for a in np.indices(s_abc[0].shape[1:]))
+    shape = s_abc[0].shape[1:]
+    if sum(abs(m) for m in slides.values()) < GATHER * s_abc[0].shape[0]:
+        rows, cols = (a.ravel() for a in np.indices(shape))
         s_all, e_all = _at_points(s_abc, slides, rows, cols), _at_points(e_abc, slides, rows, cols)
-        coarse = np.array([_value_pts(s_all, e_all, phi) for phi in np.arange(COARSE_ANGLES) * step])
-        coarse = coarse.reshape((COARSE_ANGLES,) + s_abc[0].shape[1:])
+        coarse = np.array([_value_pts(s_all, e_all, phi) for phi in np.arange(COARSE_ANGLES) * step]).T
     else:
-        coarse = np.array([_value(s_abc, e_abc, slides, phi) for phi in np.arange(COARSE_ANGLES) * step])
-    shape = coarse.shape[1:]
+        coarse = _coarse_field(s_abc, e_abc, slides, np.arange(COARSE_ANGLES) * step)
     nx = shape[-1]
 
     gathered: dict = {}  # the selection's histories, gathered once for the second pass's sixteen planes
@@ -230,25 +237,37 @@ def _search_field(s_abc, e_abc, slides: dict) -> tuple:
             gathered["pts"] = (_at_points(s_abc, slides, rows, cols), _at_points(e_abc, slides, rows, cols))
         return _value_pts(*gathered["pts"], phi)
 
-    best, where = _refine(coarse.reshape(COARSE_ANGLES, -1), value)
+    best, where = _refine(np.ascontiguousarray(coarse), value)
     return best.reshape(shape), where.reshape(shape)
 
 
-def _value(s_abc, e_abc, slides: dict, phi: float) -> np.ndarray:
-    """SWT on the plane φ at every point (leading, x)."""
-    c2, s2 = math.cos(2.0 * phi), math.sin(2.0 * phi)
+def _coarse_field(s_abc, e_abc, slides: dict, phis: np.ndarray) -> np.ndarray:
+    """SWT on each plane φ at every point: (point, angle), the points (leading, x) in order.  A state's normal
+    stress and strain are projected once per plane over the field, and a sliding state's window is a running
+    extreme of that projection along x: each position of the window costs one comparison, not (gathered) a
+    projection."""
+    # (the cosines as the gathered pass takes them, one by one: the same planes to the last bit)
+    c2 = np.array([np.cos(2.0 * phi) for phi in phis])[:, None, None]
+    s2 = np.array([np.sin(2.0 * phi) for phi in phis])[:, None, None]
 
-    def extremes(abc):
-        values = abc[0] + abc[1] * c2 + abc[2] * s2
-        hi, lo = values.max(axis=0), values.min(axis=0)
-        for k, m in slides.items():  # one plane for every point: a running filter of the state's values
-            hi = np.maximum(hi, _sliding(values[k], m, np.maximum))
-            lo = np.minimum(lo, _sliding(values[k], m, np.minimum))
+    def extremes(abc, low: bool):
+        hi = lo = None
+        for t in range(abc[0].shape[0]):
+            # laid (angle, x, leading): the planes' sums run over whole contiguous fields, a window's shift too
+            values = _project(tuple(np.ascontiguousarray(a[t].T) for a in abc), c2, s2)
+            for pick in (np.maximum, np.minimum)[:1 + low]:
+                own = [values] + ([_sliding(values.transpose(1, 0, 2), slides[t], pick).transpose(1, 0, 2)]
+                                  if t in slides else [])
+                kept = hi if pick is np.maximum else lo
+                for v in own:
+                    kept = v.copy() if kept is None else pick(kept, v, out=kept)
+                hi, lo = (kept, lo) if pick is np.maximum else (hi, kept)
         return hi, lo
 
-    s_hi, _ = extremes(s_abc)
-    e_hi, e_lo = extremes(e_abc)
-    return np.maximum(s_hi, 0.0) * 0.5 * (e_hi - e_lo)
+    s_hi, _ = extremes(s_abc, False)
+    e_hi, e_lo = extremes(e_abc, True)
+    out = np.maximum(s_hi, 0.0) * 0.5 * (e_hi - e_lo)  # (angle, x, leading)
+    return out.transpose(2, 1, 0).reshape(-1, len(phis))
 
 
 def _at_points(abc: tuple, slides: dict, rows: np.ndarray, cols: np.ndarray) -> tuple:
@@ -269,16 +288,19 @@ def _at_points(abc: tuple, slides: dict, rows: np.ndarray, cols: np.ndarray) -> 
 
 
 def _sliding(values: np.ndarray, m: int, pick) -> np.ndarray:
-    """pick (np.maximum or np.minimum) over the window x … x + m along the last axis (m signed), the field held at
-    its edges: scipy's running filter, O(n) whatever the window."""
-    from scipy import ndimage  # (here, not at import: planning a run must not pay for it)
-    n, w = values.shape[-1], abs(m) + 1
-    run = ndimage.maximum_filter1d if pick is np.maximum else ndimage.minimum_filter1d
-    padded = np.concatenate([np.repeat(values[..., :1], w, axis=-1), values,
-                             np.repeat(values[..., -1:], w, axis=-1)], axis=-1)
-    centred = run(padded, w, axis=-1)  # entry i: the window from i − w//2, w long
-    start = w + w // 2 + (0 if m > 0 else m)  # the window from x (m > 0) or from x + m (m < 0)
-    return centred[..., start:start + n]
+    """pick (np.maximum or np.minimum) over the window x + 1 … x + m along the first axis (x − |m| … x − 1 for
+    m < 0), the field held at its edges.  By doubling spans: log₂|m| + 1 comparisons a point whatever the window
+    (an extreme is exact in any grouping: the same values as one by one)."""
+    n, w = values.shape[0], abs(m)
+    held = np.repeat(values[-1:] if m > 0 else values[:1], w, axis=0)
+    padded = np.concatenate([values, held] if m > 0 else [held, values], axis=0)
+    run, span = padded, 1  # run[i]: the extreme of padded[i : i + span]
+    while 2 * span <= w:
+        run, span = pick(run[:-span], run[span:]), 2 * span
+    if span < w:
+        run = pick(run[:span - w], run[w - span:])
+    start = 1 if m > 0 else 0  # (padded's entry x + 1 is the field's x + 1; for m < 0 its entry x is x − |m|)
+    return run[start:start + n]
 
 
 def ruiz(tensile: np.ndarray, shear: np.ndarray, slip: np.ndarray) -> np.ndarray:
