@@ -181,20 +181,34 @@ def _refine(coarse: np.ndarray, value) -> tuple:
     """From the 5° pass's values (point, angle): each point's two best planes' neighbourhoods degree by degree,
     where the 5° value is at least FINE_SHARE of the peak (a fretting cycle's mirror-image planes often tie to
     round-off, and the pass about the wrong one of two near-equal peaks can miss the best by 10 % or more).
-    ``value(phi, selection)`` → the SWT at the selected points on their planes φ."""
+    ``value(phi, selection)`` → the SWT at the selected points on their planes φ, phi (planes, selection)."""
     step = np.pi / COARSE_ANGLES
     order = np.argsort(coarse, axis=1)  # (each point's angles in a row: the sort reads them contiguous)
     best = np.take_along_axis(coarse, order[:, -1:], 1)[:, 0]
     where = order[:, -1] * step
     sel = np.flatnonzero(best >= FINE_SHARE * best.max()) if best.max() > 0 else np.zeros(0, int)
+    top, second = order[sel, -1], order[sel, -2]
+    ks = np.array([k for k in range(-FINE_HALF, FINE_HALF + 1) if k])
+    centres = np.concatenate([np.repeat(top[None], ks.size, 0), np.repeat(second[None], ks.size, 0)])
+    offsets = np.concatenate([ks, ks])[:, None] * np.ones(sel.size, int)  # (16, sel): the planes in degrees
+    # the two best are next to each other at almost every point: their neighbourhoods share four planes, each
+    # evaluated once (the planes, in degrees from the lower of the two, are then the same twelve at every point)
+    low = np.where((second - top) % COARSE_ANGLES == 1, top, second)
+    pair = ((second - top) % COARSE_ANGLES == 1) | ((top - second) % COARSE_ANGLES == 1)
+    degrees = (centres - low) % COARSE_ANGLES * (ANGLES // COARSE_ANGLES) + offsets  # (16, sel), from `low`
+    shared = np.unique(degrees[:, pair], axis=None) if pair.any() else np.zeros(0, int)
+    values = np.empty(degrees.shape)
+    if pair.any():
+        phi = np.mod(low[pair] * step + shared[:, None] * (np.pi / ANGLES), np.pi)
+        got = value(phi, sel[pair])
+        values[:, pair] = got[np.searchsorted(shared, degrees[:, pair]), np.arange(pair.sum())]
+    if (~pair).any():
+        values[:, ~pair] = value(np.mod(centres[:, ~pair] * step + offsets[:, ~pair] * (np.pi / ANGLES), np.pi),
+                                 sel[~pair])
     b, w = best[sel], where[sel]
-    for centre in (order[sel, -1] * step, order[sel, -2] * step):
-        for k in range(-FINE_HALF, FINE_HALF + 1):
-            if k:
-                phi = np.mod(centre + k * (np.pi / ANGLES), np.pi)
-                v = value(phi, sel)
-                better = v > b
-                b, w = np.where(better, v, b), np.where(better, phi, w)
+    for v, d in zip(values, np.mod(centres * step + offsets * (np.pi / ANGLES), np.pi)):  # in the search's order
+        better = v > b
+        b, w = np.where(better, v, b), np.where(better, d, w)
     best[sel], where[sel] = b, w
     return best, where
 
@@ -229,13 +243,10 @@ def _search_field(s_abc, e_abc, slides: dict) -> tuple:
         coarse = _coarse_field(s_abc, e_abc, slides, np.arange(COARSE_ANGLES) * step)
     nx = shape[-1]
 
-    gathered: dict = {}  # the selection's histories, gathered once for the second pass's sixteen planes
-
     def value(phi, sel):
-        if "pts" not in gathered:
-            rows, cols = np.divmod(sel, nx)
-            gathered["pts"] = (_at_points(s_abc, slides, rows, cols), _at_points(e_abc, slides, rows, cols))
-        return _value_pts(*gathered["pts"], phi)
+        rows, cols = np.divmod(sel, nx)
+        pts = (_at_points(s_abc, slides, rows, cols), _at_points(e_abc, slides, rows, cols))
+        return np.array([_value_pts(*pts, row) for row in phi])
 
     best, where = _refine(np.ascontiguousarray(coarse), value)
     return best.reshape(shape), where.reshape(shape)
