@@ -86,6 +86,7 @@ def evaluate(spec: FatigueSpec, x: np.ndarray, dx: float, youngs: float, cyc, fu
     p, q, travel = p[keep], q[keep], travel[keep]
     slid = {keep.index(k): m for k, m in slid.items()}  # (every sliding state is kept, and the one before it)
     p_flat, q_flat = history.on_flat(p, travel, x, dx), history.on_flat(q, travel, x, dx)
+    p_flat, q_flat, slid = _distinct(p_flat, q_flat, slid)
     cols = history.window(p_flat)
     z = spec.depths
     nz, nx = len(z), len(x)
@@ -152,6 +153,19 @@ def _thinned(shear: np.ndarray, slid: dict) -> list:
     keep = ({0, states - 1, int(np.argmax(force)), int(np.argmin(force))} | turns | set(slid)
             | {k - 1 for k in slid} | set(range(0, states, stride)))
     return sorted(keep)
+
+
+def _distinct(p_flat: np.ndarray, q_flat: np.ndarray, slid: dict) -> tuple:
+    """The states without those whose tractions on the flat another state repeats exactly (a closed loop's start
+    is its end: a fifth of gross slip's stresses and searches): the extremes over the cycle are the same."""
+    states = len(p_flat)
+    same = lambda j, k: np.array_equal(p_flat[j], p_flat[k]) and np.array_equal(q_flat[j], q_flat[k])  # noqa: E731
+    # (kept: a sliding state, whose window counts, or the last of equal ones)
+    drop = [j for j in range(states) if j not in slid and any(same(j, k) for k in range(j + 1, states))]
+    if not drop:
+        return p_flat, q_flat, slid
+    keep = [k for k in range(states) if k not in drop]
+    return p_flat[keep], q_flat[keep], {keep.index(k): m for k, m in slid.items()}
 
 
 def _widen(a: np.ndarray, cols: slice, nx: int) -> np.ndarray:
