@@ -8,6 +8,7 @@ over every other state); the run's time with fatigue against the same run withou
 life against the stroke with wear and without.
 
     python scripts/study_fatigue.py            # → scripts/results/fatigue_states.txt
+    python scripts/study_fatigue.py --cost     # the cost table alone, printed (not written)
 """
 from __future__ import annotations
 
@@ -24,7 +25,7 @@ from fretsim.runner import run
 ROOT = Path(__file__).resolve().parent.parent
 CASE = ROOT / "cases" / "ti_fretting_fatigue.yaml"
 STROKES = ("4 um", "5 um")  # near the transition, where cracks start within the run (with wear, 10⁶ cycles)
-COST_STROKES = ("2 um", "5 um", "10 um", "25 um")
+COST_STROKES = ("2 um", "5 um", "10 um", "25 um", "10 um uniform", "25 um uniform")  # uniform: model.slip
 CURVE = ("1 um", "2 um", "3 um", "4 um", "5 um", "6 um", "8 um", "10 um", "15 um", "25 um")
 NO_WEAR = ("materials.moving.wear_coefficient=0 1/MPa", "materials.stationary.wear_coefficient=0 1/MPa")
 DENSITIES = ((2, 4), (3, 8), (6, 16), (12, 32), (24, 64))  # (per decade, linear); the last is the reference
@@ -50,7 +51,31 @@ def _run(case) -> tuple:
     return crack, float(st["fatigue_damage"].max()), seconds, out.summary["contact_solves"]
 
 
+def _cost() -> list:
+    """The run with fatigue against the same without, median of 3, in turn."""
+    lines = ["", "cost: the shipped case (10⁵ cycles) with fatigue against the same without "
+                 "(materials.stationary.fatigue null), median of 3, in turn"]
+    for name in COST_STROKES:
+        stroke, *slip = name.split(" um")
+        extra = [f"loading.stroke={stroke} um", "grid.error_estimate=none"] + (
+            ["model.slip=uniform"] if slip[0].strip() else [])
+        with_f, without = [], []
+        for _ in range(3):
+            for fatigue, out in (((), with_f), (("materials.stationary.fatigue=null",), without)):
+                case = load_case(str(CASE), [*extra, *fatigue])
+                with tempfile.TemporaryDirectory() as tmp:
+                    t = time.perf_counter()
+                    run(case, Path(tmp) / "r.h5")
+                    out.append(time.perf_counter() - t)
+        a, b = sorted(with_f)[1], sorted(without)[1]
+        lines.append(f"  {name:14s}: with {a:.2f} s, without {b:.2f} s, ratio {a / b:.2f}")
+    return lines
+
+
 def main() -> None:
+    if "--cost" in sys.argv:
+        print("\n".join(_cost()))
+        return
     lines = [__doc__.split("\n\n")[0], "", f"case {CASE.name}; grid.error_estimate none", "",
              "stroke   states/decade linear   crack cycle   damage at end   vs densest   estimated   run s   solves"]
     for stroke in STROKES:
@@ -66,20 +91,7 @@ def main() -> None:
             lines.append(f"{stroke:8s} {per_decade:13d} {linear:6d}   {crack:11.6g}   {dmg:13.4g}   {diff:>10s}   "
                          f"{said:9.2%}   {sec:5.2f}   {solves:6d}")
         damage.STATES_PER_DECADE, damage.LINEAR_STATES = DEFAULT
-    lines += ["", "cost: the shipped case (10⁵ cycles) with fatigue against the same without "
-                  "(materials.stationary.fatigue null), median of 3, in turn"]
-    for stroke in COST_STROKES:
-        with_f, without = [], []
-        for _ in range(3):
-            with_f.append(_crack(stroke, *DEFAULT)[2])
-            case = load_case(str(CASE), [f"loading.stroke={stroke}", "grid.error_estimate=none",
-                                         "materials.stationary.fatigue=null"])
-            with tempfile.TemporaryDirectory() as tmp:
-                t = time.perf_counter()
-                run(case, Path(tmp) / "r.h5")
-                without.append(time.perf_counter() - t)
-        a, b = sorted(with_f)[1], sorted(without)[1]
-        lines.append(f"  {stroke:6s}: with {a:.2f} s, without {b:.2f} s, ratio {a / b:.2f}")
+    lines += _cost()
     lines += ["", "the interaction: cycles to crack initiation (10⁶ cycles run; '>' none by then, with Miner's sum)",
               "stroke    with wear                 without wear (k = 0)"]
     for stroke in CURVE:
