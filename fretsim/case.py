@@ -1093,9 +1093,9 @@ def _scheme(jumping: dict, jumping_raw: dict) -> tuple[Optional[str], Optional[s
 
 
 def _check_fatigue(r: "_Reader", materials: dict, model: dict, mu: Optional[float], crack_limit, stresses) -> None:
-    """What fretting fatigue needs: the flat's constants (the moving body's half-space is not modelled yet), a
-    friction coefficient (the shear traction drives the cracks), a line contact (the 3D stresses are not wired
-    yet); the crack limit and the stress output need the constants."""
+    """What fretting fatigue needs: the flat's constants (the moving body's half-space is not modelled yet) and a
+    friction coefficient (the shear traction drives the cracks); the crack limit and the stress output need the
+    constants."""
     if any(path.startswith("materials.stationary.fatigue") for path, _ in r.problems):
         return  # (already said what is wrong with them)
     given = {body for body, m in materials.items() if m.fatigue is not None}
@@ -1110,9 +1110,6 @@ def _check_fatigue(r: "_Reader", materials: dict, model: dict, mu: Optional[floa
     if mu is None or mu == 0:
         r.fail("materials.stationary.fatigue", "fretting fatigue needs loading.friction_coefficient (> 0): the "
                                                "shear traction is what opens the cracks")
-    if model.get("dimension") != "2d":
-        r.fail("materials.stationary.fatigue", "fretting fatigue is computed in plane strain only so far (the 3D "
-                                               "stresses are not wired in); set model.dimension: 2d")
 
 
 def _check_model(r: "_Reader", geometry, materials: dict, model: dict, mu: Optional[float]) -> None:

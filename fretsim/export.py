@@ -16,7 +16,7 @@ def _col(name: str, units: str) -> str:
 
 def export_csv(res: Results, outdir: str | Path) -> list[Path]:
     """Write history.csv, summary.csv, inputs.csv, fields.csv (long format: cycle, x, y, fields), with fatigue
-    subsurface.csv (cycle, z, x, the SWT and its plane) and, for a
+    subsurface.csv (cycle, z, x — and y in 3D — the SWT and its plane) and, for a
     cycle with friction, fretting_loop.csv (cycle, displacement, force round each recorded loop) to outdir."""
     outdir = Path(outdir)
     outdir.mkdir(parents=True, exist_ok=True)
@@ -55,15 +55,21 @@ def export_csv(res: Results, outdir: str | Path) -> list[Path]:
     write("fields.csv", ["cycle", "x [mm]", "y [mm]"] + [_col(k, res.units.get(f"fields/{k}", "")) for k in names],
           rows)
     sub = res.subsurface
-    if sub:  # fretting fatigue: the flat's fields below its surface, long format (cycle, z, x)
+    if sub:  # fretting fatigue: the flat's fields below its surface, long format (cycle, z, x), and y in 3D
         names = [k for k in sub if k != "z"]
-        Z, X = np.meshgrid(sub["z"], res.x, indexing="ij")
+        three = sub[names[0]].ndim == 4
+        if three:
+            Z, Y, X = np.meshgrid(sub["z"], res.y, res.x, indexing="ij")
+            where = [Z.ravel(), X.ravel(), Y.ravel()]
+        else:
+            Z, X = np.meshgrid(sub["z"], res.x, indexing="ij")
+            where = [Z.ravel(), X.ravel()]
         rows = []
         for s, cycle in enumerate(res.fields["cycle"]):
-            cols = [np.full(Z.size, cycle), Z.ravel(), X.ravel()] + [sub[k][s].ravel() for k in names]
+            cols = [np.full(Z.size, cycle), *where] + [sub[k][s].ravel() for k in names]
             rows.extend(zip(*(c.tolist() for c in cols)))
-        write("subsurface.csv", ["cycle", "z [mm]", "x [mm]"] + [_col(k, res.units.get(f"fields/{k}", ""))
-                                                                   for k in names], rows)
+        write("subsurface.csv", ["cycle", "z [mm]", "x [mm]"] + (["y [mm]"] if three else [])
+              + [_col(k, res.units.get(f"fields/{k}", "")) for k in names], rows)
     loop = res.fretting_loop
     if loop.get("displacement") is not None and loop["displacement"].size:
         rows = [(int(c), float(u), float(q)) for c, us, qs in zip(loop["cycle"], loop["displacement"],

@@ -961,13 +961,19 @@ def _fatigue(res: Results):
     swt, angle, z = sub["swt"], sub["swt_plane_angle"], sub["z"] * 1e3  # depths in µm
     peaks = np.array([np.nanmax(f) if np.isfinite(f).any() else np.nan for f in swt])
     k = int(np.nanargmax(peaks)) if np.isfinite(peaks).any() else len(peaks) - 1
-    field, x = swt[k], res.x * 1e3  # x in µm as well: the planes are drawn at their true angle
+    field, plane, x = swt[k], angle[k], res.x * 1e3  # x in µm as well: the planes are drawn at their true angle
+    where = ""
+    if field.ndim == 3:  # 3D: the section along the stroke through the state's peak (its planes projected on it)
+        row = int(np.unravel_index(np.nanargmax(np.nan_to_num(field, nan=-np.inf)), field.shape)[1])
+        field, plane = field[:, row, :], plane[:, row, :]
+        where = f" at y = {res.y[row] * 1e3:.0f} µm"
     top = float(np.nanmax(field)) if np.isfinite(field).any() else 0.0
     fig, axes = plt.subplots(1, 3, figsize=(15, 4.6), gridspec_kw={"width_ratios": [1.8, 1.1, 1]})
     if top > 0:
         _swt_overview(axes[0], fig, field, x, z, top, summary)
-        _hot_spot(axes[1], field, angle[k], x, z, top)
-    axes[0].set_title(f"stationary body, {_cycles_label(res.fields['cycle'][k])}: SWT on the critical plane")
+        _hot_spot(axes[1], field, plane, x, z, top)
+    axes[0].set_title(f"stationary body, {_cycles_label(res.fields['cycle'][k])}{where}: SWT on the critical plane",
+                      **({"fontsize": 10} if where else {}))
     ax = axes[2]
     ax.plot(res.fields["cycle"], peaks, "o-", ms=4, label="SWT peak at each recorded state")
     crack = summary.get("cycles_to_crack_initiation", np.nan)

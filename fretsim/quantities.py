@@ -122,6 +122,8 @@ SUMMARY: dict[str, Figure] = {
     "ruiz_max": Figure("MPa^2*mm"),
     "cycles_to_crack_initiation": Figure("cycles", nan=True),
     "crack_location_x_mm": Figure("mm", nan=True),
+    "swt_location_y_mm": Figure("mm", nan=True),  # 3D only: across the stroke
+    "crack_location_y_mm": Figure("mm", nan=True),  # 3D only
     "fatigue_damage": Figure("1"),
     "damage_mode": Figure(""),
     "fatigue_states_error": Figure("1", nan=True),  # the crack cycle's (or damage's) change with half the states

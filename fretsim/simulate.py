@@ -288,8 +288,7 @@ class _Loop:
         """A block's start: the new block's cycle at the same wear restarts Miner's sums (loop.blocks)."""
         if self.miner is not None and cyc.tractions is not None:
             s = self.s
-            self.miner.restart(self.n, evaluate(s.fatigue, s.grid.x, s.grid.dx, s.fatigue.curve.youngs_modulus, cyc,
-                                                full=False))
+            self.miner.restart(self.n, self._evaluate(cyc, full=False))
 
     def _fatigue(self, step: Step) -> bool:
         """The flat's fatigue at a detailed state (or at a wear limit's, detailed now) added to Miner's sum; True
@@ -301,15 +300,19 @@ class _Loop:
             if not step.is_snapshot:
                 return False
             cyc = self.cycle_at(self.n, self.p, detail=True)
-        step.fatigue = evaluate(s.fatigue, s.grid.x, s.grid.dx, s.fatigue.curve.youngs_modulus, cyc,
-                                full=step.is_snapshot)
+        step.fatigue = self._evaluate(cyc, full=step.is_snapshot)
         had = self.miner.crack is not None
-        self.miner.add(self.n, step.fatigue, s.grid.x)
+        self.miner.add(self.n, step.fatigue, s.grid.x, s.grid.y)
         stop = s.fatigue.crack_limit and not had and self.miner.crack is not None
         if stop and not step.fatigue.full:  # the run ends here: this state is recorded, with its fields in full
-            step.fatigue = evaluate(s.fatigue, s.grid.x, s.grid.dx, s.fatigue.curve.youngs_modulus, cyc)
+            step.fatigue = self._evaluate(cyc)
             self.miner.peak(step.fatigue)  # (its largest shear: the state's every layer)
         return stop
+
+    def _evaluate(self, cyc: Cycle, full: bool = True):
+        s = self.s
+        return evaluate(s.fatigue, s.grid.x, s.grid.dx, s.fatigue.curve.youngs_modulus, cyc, full=full, y=s.grid.y,
+                        dy=s.grid.dy)
 
     def restored_cycle(self) -> Cycle:
         """The cycle at the restored state: rebuilt from its pressure where the rates are linear in it, else solved

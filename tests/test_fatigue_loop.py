@@ -237,7 +237,6 @@ def test_the_uniform_and_the_coulomb_cycle_give_the_same_swt_in_gross_slip():
     ("materials.moving.fatigue={strength_coefficient: 2030 MPa, strength_exponent: -0.1, "
      "ductility_coefficient: 0.8, ductility_exponent: -0.7}", "materials.moving.fatigue"),
     ("loading.friction_coefficient=null", "materials.stationary.fatigue"),
-    ("model.dimension=3d", "materials.stationary.fatigue"),
     ("materials.stationary.fatigue.strength_exponent=0.1", "materials.stationary.fatigue.strength_exponent"),
     ("materials.stationary.fatigue.critical_distance=25", "materials.stationary.fatigue.critical_distance"),
 ])

@@ -73,13 +73,28 @@ class FatigueState:
     ruiz_max: float  # MPa²·mm
     stresses: Optional[tuple] = None  # σx, σz, τxz each as its largest and smallest over the cycle, fields (depth, x)
     full: bool = True  # a recorded state: every layer, and the figures above (else the damage's layers only)
+    # 3D (fields (depth, y, x)): where the peak is across the stroke, and the critical plane's normal out of the
+    # x–z plane (``angle`` is then its angle from x towards z in that plane: fretsim.fatigue.field3d.plane_angles)
+    swt_y: float = math.nan  # mm
+    azimuth: Optional[np.ndarray] = None  # rad
 
 
-def evaluate(spec: FatigueSpec, x: np.ndarray, dx: float, youngs: float, cyc, full: bool = True) -> FatigueState:
+def evaluate(spec: FatigueSpec, x: np.ndarray, dx: float, youngs: float, cyc, full: bool = True,
+             y: Optional[np.ndarray] = None, dy: float = math.nan) -> FatigueState:
     """The flat's fatigue at a state from its cycle's tractions (``cyc.tractions``: pressure, shear, travel, each
-    (states, 1, nx)).  ``full``: a recorded state, whose fields are written and whose figures the summary takes;
+    (states, ny, nx)).  ``full``: a recorded state, whose fields are written and whose figures the summary takes;
     otherwise (a fatigue state between them, for the damage only) with a critical distance only the layers the
-    line method averages over are computed."""
+    line method averages over are computed.  A 3D grid (``y``, ``dy``, more than one row): the fields by
+    :func:`fretsim.fatigue.field3d.fields_3d`, over (depth, y, x)."""
+    if np.asarray(cyc.tractions[0]).shape[1] > 1:
+        from fretsim.fatigue.field3d import fields_3d
+        p, q, travel = (np.asarray(a, dtype=float) for a in cyc.tractions)
+        slid = slides(p, travel, dx)
+        keep = _thinned(q, slid)
+        slid = {keep.index(k): m for k, m in slid.items()}
+        f = fields_3d(spec, x, dx, dy, youngs, (p[keep], q[keep], travel[keep]), slid, cyc.slip_stationary, full, SKIP)
+        return _state(spec, spec.depths, x, f.swt, f.angle, f.extremes, f.shear_max, f.shear_depth, f.tension, f.ruiz,
+                      full, y=y, azimuth=f.azimuth)
     p, q, travel = (np.asarray(a)[:, 0, :] for a in cyc.tractions)
     slid = slides(p, travel, dx)
     keep = _thinned(q, slid)
@@ -174,12 +189,14 @@ def _widen(a: np.ndarray, cols: slice, nx: int) -> np.ndarray:
     return out
 
 
-def _state(spec, z, x, swt, angle, amplitudes, max_shear, shear_depth, tension, ruiz, full) -> FatigueState:
+def _state(spec, z, x, swt, angle, amplitudes, max_shear, shear_depth, tension, ruiz, full, y=None,
+           azimuth=None) -> FatigueState:
     k = np.unravel_index(np.argmax(swt), swt.shape)
     return FatigueState(swt=swt, angle=angle, life=spec.curve.lives(damage_parameter(spec, swt)),
                         max_shear=max_shear, max_shear_depth=shear_depth, max_tension=tension,
-                        swt_max=float(swt[k]), swt_x=float(x[k[1]]), swt_depth=float(z[k[0]]), ruiz_max=ruiz,
-                        stresses=amplitudes, full=full)
+                        swt_max=float(swt[k]), swt_x=float(x[k[-1]]), swt_depth=float(z[k[0]]), ruiz_max=ruiz,
+                        stresses=amplitudes, full=full, swt_y=float(y[k[1]]) if swt.ndim == 3 else math.nan,
+                        azimuth=azimuth)
 
 
 def damage_parameter(spec: FatigueSpec, swt: np.ndarray) -> np.ndarray:
@@ -192,9 +209,15 @@ def damage_parameter(spec: FatigueSpec, swt: np.ndarray) -> np.ndarray:
     z = np.concatenate([[0.0], spec.depths[1:]])  # the surface layer is at the surface
     inside = z < L
     zs = np.concatenate([z[inside], [L]])
-    at_l = np.array([np.interp(L, z, swt[:, j]) for j in range(swt.shape[1])])
-    values = np.concatenate([swt[inside], at_l[None, :]], axis=0)
-    return np.trapezoid(values, zs, axis=0)[None, :] / L
+    columns = swt.reshape(len(z), -1)  # (depth, surface point): a 3D field's (y, x) flattened
+    k = int(np.searchsorted(z, L))  # L lies in [z[k − 1], z[k]) (or beyond the deepest layer: the last value)
+    if L >= z[-1]:
+        at_l = columns[-1]
+    else:
+        slope = (columns[k] - columns[k - 1]) / (z[k] - z[k - 1])  # (np.interp's own arithmetic, to the bit)
+        at_l = slope * (L - z[k - 1]) + columns[k - 1]
+    values = np.concatenate([columns[inside], at_l[None, :]], axis=0)
+    return (np.trapezoid(values, zs, axis=0) / L).reshape((1,) + swt.shape[1:])
 
 
 @dataclass
@@ -213,9 +236,10 @@ class Miner:
     half_crack: float = math.nan
     count: int = 0  # states added
 
-    def add(self, n: int, state: FatigueState, x: Optional[np.ndarray] = None) -> None:
-        """Count the damage from the last state to this one at cycle ``n``; ``x`` the grid's element centres (mm),
-        where a crack is said to start (kept in mm: a later widening of the grid moves the columns, not the place)."""
+    def add(self, n: int, state: FatigueState, x: Optional[np.ndarray] = None, y: Optional[np.ndarray] = None) -> None:
+        """Count the damage from the last state to this one at cycle ``n``; ``x`` (and in 3D ``y``) the grid's
+        element centres (mm), where a crack is said to start (kept in mm: a later widening of the grid moves the
+        columns, not the place)."""
         rate = _rate(state)
         if self.damage is None:
             self.damage, self.half, self.half_rate, self.half_cycle = np.zeros_like(rate), np.zeros_like(rate), rate, n
@@ -224,8 +248,10 @@ class Miner:
             before = self.damage
             self.damage = before + 0.5 * (self.rate + rate) * span
             if self.crack is None and (self.damage >= 1.0).any():
-                cycle, (_, column) = _crossing(before, self.rate, rate, span, self.cycle)
-                self.crack = (cycle, float(x[column]) if x is not None else float(column))
+                cycle, index = _crossing(before, self.rate, rate, span, self.cycle)
+                self.crack = (cycle, float(x[index[-1]]) if x is not None else float(index[-1]))
+                if len(index) == 3:  # 3D: (layer, row, column), the row's y too
+                    self.crack += (float(y[index[1]]) if y is not None else float(index[1]),)
             if self.count % 2 == 0:
                 self._add_half(n, rate)
         self.rate, self.cycle = rate, float(n)
@@ -251,7 +277,8 @@ class Miner:
         states, over the recorded states."""
         for key, value, where in (("max_shear", state.max_shear, state.max_shear_depth),
                                   ("max_tension", state.max_tension, 0.0), ("ruiz_max", state.ruiz_max, 0.0),
-                                  ("swt_max", state.swt_max, (state.swt_x, state.swt_depth))):
+                                  ("swt_max", state.swt_max, (state.swt_x, state.swt_depth)
+                                   + ((state.swt_y,) if math.isfinite(state.swt_y) else ()))):
             if math.isfinite(value) and (key not in self.peaks or value > self.peaks[key][0]):
                 self.peaks[key] = (value, where)
 
@@ -285,11 +312,14 @@ class Miner:
         """For the loop's checkpoint (flat arrays and numbers)."""
         if self.damage is None:
             return {}
-        # (layers, 1, x): the grid's (y, x) last, so that a widening of the grid pads them as it pads the wear
-        out = {"fatigue_damage": self.damage[:, None, :], "fatigue_rate": self.rate[:, None, :],
-               "fatigue_cycle": self.cycle}
-        out.update({"fatigue_half": self.half[:, None, :], "fatigue_half_rate": self.half_rate[:, None, :],
+        # (layers, y, x): the grid's (y, x) last, so that a widening of the grid pads them as it pads the wear (a
+        # line contact's one row restored: fatigue_dims 3 marks a 3D grid's)
+        grid = (lambda a: a) if self.damage.ndim == 3 else (lambda a: a[:, None, :])  # noqa: E731
+        out = {"fatigue_damage": grid(self.damage), "fatigue_rate": grid(self.rate), "fatigue_cycle": self.cycle}
+        out.update({"fatigue_half": grid(self.half), "fatigue_half_rate": grid(self.half_rate),
                     "fatigue_half_cycle": float(self.half_cycle), "fatigue_count": int(self.count)})
+        if self.damage.ndim == 3:
+            out["fatigue_dims"] = 3
         if math.isfinite(self.half_crack):
             out["fatigue_half_crack"] = float(self.half_crack)
         if self.crack is not None:
@@ -304,17 +334,16 @@ class Miner:
             return cls()
         crack = None
         if "fatigue_crack" in st:
-            c = np.asarray(st["fatigue_crack"], dtype=float)
-            crack = (float(c[0]), float(c[1]))
+            crack = tuple(float(c) for c in np.asarray(st["fatigue_crack"], dtype=float))
         peaks = {}
         for key in ("max_shear", "max_tension", "ruiz_max", "swt_max"):
             if f"fatigue_peak_{key}" in st:
                 v = [float(a) for a in np.atleast_1d(st[f"fatigue_peak_{key}"])]
                 peaks[key] = (v[0], tuple(v[1:]) if len(v) > 2 else v[1])
-        return cls(np.asarray(st["fatigue_damage"], dtype=float)[:, 0, :],
-                   np.asarray(st["fatigue_rate"], dtype=float)[:, 0, :], float(st["fatigue_cycle"]), crack, peaks,
-                   np.asarray(st["fatigue_half"], dtype=float)[:, 0, :],
-                   np.asarray(st["fatigue_half_rate"], dtype=float)[:, 0, :], float(st["fatigue_half_cycle"]),
+        grid = ((lambda a: np.asarray(a, dtype=float)) if int(st.get("fatigue_dims", 2)) == 3 else
+                (lambda a: np.asarray(a, dtype=float)[:, 0, :]))  # noqa: E731
+        return cls(grid(st["fatigue_damage"]), grid(st["fatigue_rate"]), float(st["fatigue_cycle"]), crack, peaks,
+                   grid(st["fatigue_half"]), grid(st["fatigue_half_rate"]), float(st["fatigue_half_cycle"]),
                    float(st.get("fatigue_half_crack", math.nan)), int(st["fatigue_count"]))
 
 
@@ -352,9 +381,14 @@ def summary(spec: FatigueSpec, state: dict, x: np.ndarray, limit: Optional[tuple
     miner = Miner.from_state(state)
     nan = float("nan")
     peak = lambda key: miner.peaks.get(key, (nan, nan))  # noqa: E731
-    swt, (swt_x, swt_z) = peak("swt_max")[0], (peak("swt_max")[1] if "swt_max" in miner.peaks else (nan, nan))
+    swt, where = peak("swt_max")[0], (tuple(peak("swt_max")[1]) if "swt_max" in miner.peaks else (nan, nan))
+    swt_x, swt_z = where[:2]
     crack = miner.crack[0] if miner.crack is not None else nan
     wear_limit = limit[1] if limit is not None and limit[0] != "crack_initiation" else nan
+    across = {}
+    if len(where) == 3 or int(state.get("fatigue_dims", 2)) == 3:  # 3D: where across the stroke, too
+        across = {"swt_location_y_mm": where[2] if len(where) == 3 else nan,
+                  "crack_location_y_mm": miner.crack[2] if miner.crack is not None else nan}
     return {
         "max_shear_stress_MPa": peak("max_shear")[0],
         "max_shear_stress_depth_um": peak("max_shear")[1] * 1e3,
@@ -368,4 +402,5 @@ def summary(spec: FatigueSpec, state: dict, x: np.ndarray, limit: Optional[tuple
         "fatigue_damage": float(miner.damage.max()) if miner.damage is not None else nan,
         "damage_mode": damage_mode(crack, wear_limit),
         "fatigue_states_error": miner.states_error(),
+        **across,
     }

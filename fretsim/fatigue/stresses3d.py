@@ -61,6 +61,7 @@ All lengths in mm, tractions and stresses in MPa; the grid's arrays are shaped (
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import lru_cache
 
 import numpy as np
 
@@ -232,3 +233,34 @@ def _check(x, y, dx, dy, tractions, depths) -> None:
         raise ValueError("the depths must be positive (below the surface); for the surface take a small depth")
     if (np.asarray(tractions[0]) < 0).any():
         raise ValueError("the pressure must be non-negative (compressive)")
+
+
+@lru_cache(maxsize=64)
+def _layer_hats(nx: int, ny: int, dx: float, dy: float, z: float, poisson: float, shape: tuple) -> np.ndarray:
+    """The pressure's and q_x's kernels at one depth, transformed on the padded ``shape``: (2, 6, ly, lx // 2 + 1).
+    Cached: a run's fatigue states mostly share a window's size, and the kernels are half a layer's cost."""
+    return _wrapped_transform(influence_kernels(nx, ny, dx, dy, z, poisson, (True, True, False))[:2], shape)
+
+
+def stress_history(pressure: np.ndarray, shear_x: np.ndarray, dx: float, dy: float, depths: np.ndarray,
+                   poisson: float) -> np.ndarray:
+    """The six stresses at every (state, depth, y, x) under each state's pressure and shear along x (arrays (state,
+    ny, nx) on a uniform grid): shape (6, state, depth, ny, nx) in :data:`COMPONENTS`' order.  The cycle's states
+    at once: each depth's kernels are made (or found) once for all of them — a fatigue state's dozen states would
+    otherwise pay the kernels a dozen times."""
+    import scipy.fft as sfft
+    from fretsim.compliance.fft import next_fast_len
+    pressure, shear_x = np.asarray(pressure, float), np.asarray(shear_x, float)
+    states, ny, nx = pressure.shape
+    depths = np.atleast_1d(np.asarray(depths, float))
+    if (depths <= 0).any():
+        raise ValueError("the depths must be positive (below the surface); for the surface take a small depth")
+    shape = (next_fast_len(2 * ny - 1, real=False), next_fast_len(2 * nx - 1, real=True))
+    p_hat = sfft.rfft2(pressure, s=shape)[:, None]  # (state, 1, ly, lx')
+    q_hat = sfft.rfft2(shear_x, s=shape)[:, None]
+    out = np.empty((6, states, depths.size, ny, nx))
+    for d, z in enumerate(depths):
+        k = _layer_hats(nx, ny, float(dx), float(dy), float(z), float(poisson), shape)
+        field = sfft.irfft2(p_hat * k[0][None] + q_hat * k[1][None], s=shape)  # (state, 6, ly, lx)
+        out[:, :, d] = np.moveaxis(field[:, :, :ny, :nx], 1, 0)
+    return out

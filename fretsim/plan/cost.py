@@ -91,9 +91,10 @@ def _fatigue_seconds(setup, op, gap, solves: int) -> float:
         return 0.0
     cycle_s = time.perf_counter() - t
     args = (setup.fatigue, setup.grid.x, setup.grid.dx, setup.fatigue.curve.youngs_modulus, cyc)
-    evaluate(*args, full=False)  # (the first pays scipy's imports and the depths' kernels, once a run)
+    grid = {"y": setup.grid.y, "dy": setup.grid.dy}
+    evaluate(*args, full=False, **grid)  # (the first pays scipy's imports and the depths' kernels, once a run)
     t = time.perf_counter()
-    evaluate(*args, full=False)
+    evaluate(*args, full=False, **grid)
     one = cycle_s * WARM_SOLVE + time.perf_counter() - t
     states = sum(1 for n in setup.fatigue.states if n <= setup.cycles)
     return one * min(states, max(solves, 1)) + 3.0 * one * len(setup.snapshots)  # (a recorded state: every layer)

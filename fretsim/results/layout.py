@@ -71,6 +71,13 @@ SUBSURFACE = {
     "swt_plane_angle": ("deg", "the critical plane's normal, from the sliding direction x towards the depth z",
                         lambda f: np.degrees(f.angle)),
 }
+# 3D (fields over (cycle, z, y, x)): the critical plane's normal out of the x–z plane, with swt_plane_angle its angle
+# from x towards z in that plane: n = ±(cos β cos θ, sin β, cos β sin θ)
+SUBSURFACE_3D = {
+    "swt_plane_azimuth": ("deg", "the critical plane's normal, out of the x-z plane towards y (3D; with "
+                                 "swt_plane_angle its angle from x towards z in that plane)",
+                          lambda f: np.degrees(f.azimuth)),
+}
 STRESSES = {
     f"stress_{c}_{end}": ("MPa", f"the stationary body's stress σ_{c} below its surface: its {end}imum over the cycle",
                           lambda f, i=2 * i + j: f.stresses[i])

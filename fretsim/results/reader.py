@@ -17,7 +17,7 @@ import numpy as np
 from fretsim.errors import ResultsFileError
 from fretsim.results.layout import (FIELDS, FIELDS_V12, FORMAT_VERSION, HISTORY, HISTORY_V11, HISTORY_V12, HISTORY_V13,
                                     HISTORY_V14, MAX_DATASET_BYTES, NAN_FIELDS, NAN_HISTORY, NAN_SUMMARY,
-                                    READABLE_FORMATS, STATUSES, STRESSES, SUBSURFACE,
+                                    READABLE_FORMATS, STATUSES, STRESSES, SUBSURFACE, SUBSURFACE_3D,
                                     in_summary_order)
 from fretsim.results.seal import (SEALED_FROM, _SCALE_ATTRS, _Damaged, _verify_attrs_seal, _verify_seal,
                                   checkpoint_digest, plain, text, verify_image)
@@ -43,7 +43,7 @@ class Results:
     inputs: dict = field(default_factory=dict)  # name: (value, units)
     overrides: list = field(default_factory=list)
     regrids: list = field(default_factory=list)  # the automatic grid's widenings (fretsim.regrid.Regrid), in order
-    subsurface: dict = field(default_factory=dict)  # fretting fatigue: z (mm) and fields (cycle, z, x) below the flat
+    subsurface: dict = field(default_factory=dict)  # fretting fatigue: z (mm), fields (cycle, z, [y,] x) below the flat
 
     @property
     def status(self) -> str:
@@ -161,7 +161,8 @@ class Results:
                 for k, v in self.fields.items() if k != "cycle"}
         if self.subsurface:  # fretting fatigue: the flat's fields below its surface
             coords["z"] = ("z", self.subsurface["z"], {"units": "mm", "long_name": "depth below the flat's surface"})
-            data.update({k: (("cycle", "z", "x"), v, {"units": self.units.get(f"fields/{k}", "")})
+            data.update({k: (("cycle", "z", "x") if v.ndim == 3 else ("cycle", "z", "y", "x"), v,
+                             {"units": self.units.get(f"fields/{k}", "")})
                          for k, v in self.subsurface.items() if k != "z"})
         data.update({k: ("step", v, {"units": self.units.get(f"history/{k}", "")})
                      for k, v in self.history.items() if k not in ("cycle", "step")})
@@ -254,7 +255,7 @@ def _read(f, path: str, for_resume: bool, seals: bool = True) -> Results:
     history = _read_history(f, version, units)
     fields = _read_fields(f, version, (ny, nx), units)
     loop = _read_loop(f, version, fields["cycle"], units)
-    subsurface = _read_subsurface(f, fields["cycle"].size, nx, units) if "z" in f["fields"] else {}
+    subsurface = _read_subsurface(f, fields["cycle"].size, (ny, nx), units) if "z" in f["fields"] else {}
     summary = _read_summary(f)
     checkpoint = _read_checkpoint(f, (ny, nx)) if "checkpoint" in f else None
     if for_resume and version != FORMAT_VERSION:
@@ -363,16 +364,20 @@ def _read_fields(f, version: str, shape: tuple, units: dict) -> dict:
     return fields
 
 
-def _read_subsurface(f, snapshots: int, nx: int, units: dict) -> dict:
-    """Fretting fatigue's depths and fields below the flat (cycle, z, x); NaN where a state had none evaluated."""
+def _read_subsurface(f, snapshots: int, grid: tuple, units: dict) -> dict:
+    """Fretting fatigue's depths and fields below the flat (cycle, z, x), or (cycle, z, y, x) on a 3D grid; NaN where
+    a state had none evaluated."""
+    ny, nx = grid
     z = _dataset(f, "fields/z", 1)
     if not z.size or not (z > 0).all() or (z.size > 1 and not (np.diff(z) > 0).all()):
         raise _Damaged("/fields/z: the depths must be positive and increasing")
     out = {"z": z}
     units["fields/z"] = "mm"
-    for k in (*SUBSURFACE, *STRESSES):
+    across = () if ny == 1 else (ny,)
+    for k in (*SUBSURFACE, *SUBSURFACE_3D, *STRESSES):
         if k in f["fields"]:
-            out[k] = _dataset(f, f"fields/{k}", 3, shape=(snapshots, z.size, nx), allow_nan=True)
+            out[k] = _dataset(f, f"fields/{k}", 3 + len(across), shape=(snapshots, z.size, *across, nx),
+                              allow_nan=True)
             units[f"fields/{k}"] = text(f["fields"][k].attrs.get("units", ""))
     return out
 

@@ -19,7 +19,7 @@ import h5py
 import numpy as np
 
 from fretsim import __version__
-from fretsim.results.layout import FIELDS, FORMAT_VERSION, STRESSES, SUBSURFACE, HISTORY, INTEGER_HISTORY, SUMMARY_UNITS, summary_long_name
+from fretsim.results.layout import FIELDS, FORMAT_VERSION, STRESSES, SUBSURFACE, SUBSURFACE_3D, HISTORY, INTEGER_HISTORY, SUMMARY_UNITS, summary_long_name
 from fretsim.results.seal import USERBLOCK, _SealingWriter, checkpoint_digest, seal_image
 from fretsim.results.reader import Results
 
@@ -62,10 +62,10 @@ class ResultsWriter:
             self.rows, self.fields, self.field_cycles = [], {k: [] for k in FIELDS}, []
             self.loops = []  # (applied displacement um, tangential force N) at each snapshot
         self.regrids = list(regrids)  # the automatic grid's widenings (fretsim.regrid.Regrid)
-        # fretting fatigue's fields below the flat at each snapshot, each (layers, 1, x), and the layers' depths
+        # fretting fatigue's fields below the flat at each snapshot, each (layers, y, x), and the layers' depths
         self.depths = previous.subsurface.get("z") if previous is not None else None
-        self.subsurface = ({k: [a[:, None, :] for a in v] for k, v in previous.subsurface.items() if k != "z"}
-                           if previous is not None else {})
+        self.subsurface = ({k: [a if a.ndim == 3 else a[:, None, :] for a in v]
+                            for k, v in previous.subsurface.items() if k != "z"} if previous is not None else {})
         self.status, self.message, self.summary = "running", "", {}
         self.state: Optional[dict] = None
         self._flushed = -math.inf
@@ -97,9 +97,10 @@ class ResultsWriter:
     def _add_subsurface(self, setup, step) -> None:
         """The flat's fields below its surface at a snapshot (NaN where the state had no fatigue evaluated)."""
         self.depths = setup.fatigue.depths
-        tables = {**SUBSURFACE, **(STRESSES if setup.fatigue.keep_stresses else {})}
+        tables = {**SUBSURFACE, **(SUBSURFACE_3D if setup.grid.shape[0] > 1 else {}),
+                  **(STRESSES if setup.fatigue.keep_stresses else {})}
         for name, (_, _, get) in tables.items():
-            shape = (len(self.depths), 1, setup.grid.shape[1])
+            shape = (len(self.depths),) + setup.grid.shape
             value = np.asarray(get(step.fatigue)) if step.fatigue is not None else np.full(shape, np.nan)
             self.subsurface.setdefault(name, []).append(value.reshape(shape))
 
@@ -266,15 +267,18 @@ class ResultsWriter:
 
 
 def _write_subsurface(writer: "ResultsWriter", w: "_SealingWriter", fl, scales: list) -> None:
-    """/fields/z and the fatigue fields over (cycle, z, x): a line contact's y (one row) dropped."""
+    """/fields/z and the fatigue fields over (cycle, z, x): a line contact's y (one row) dropped; over (cycle, z, y,
+    x) in 3D."""
     z = w.dataset(fl, "z", np.asarray(writer.depths, dtype=float), units="mm",
                   long_name="depth below the stationary body's surface")
     z.make_scale("z")
     for name, values in writer.subsurface.items():
-        units, long_name, _ = {**SUBSURFACE, **STRESSES}[name]
-        data = np.array(values, dtype=float).reshape(len(values), len(writer.depths), -1)
+        units, long_name, _ = {**SUBSURFACE, **SUBSURFACE_3D, **STRESSES}[name]
+        data = np.array(values, dtype=float)
+        rows = data.shape[2]
+        data = data.reshape(len(values), len(writer.depths), -1) if rows == 1 else data
         ds = w.dataset(fl, name, data, units=units, long_name=long_name)
-        for axis, scale in enumerate((scales[0], z, scales[-1])):
+        for axis, scale in enumerate((scales[0], z, scales[-1]) if rows == 1 else (scales[0], z, *scales[1:])):
             ds.dims[axis].attach_scale(scale)
 
 
