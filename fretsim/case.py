@@ -180,10 +180,12 @@ SCHEMA: dict[str, dict[str, Key]] = {
                                           "(p0 = 1.60 σ_y for a point contact, 1.79 σ_y for a line contact; von "
                                           "Mises, ν = 0.3, Johnson §6.2)", None,
                               plausible=(1.0, 1e5, "1 MPa to 100 GPa"), example="250 MPa"),
-        "fatigue": Key("fatigue", "opt-in fretting fatigue of this body (the stationary flat): the strain-life "
-                                  "curve's constants, a mapping of " + ", ".join(FATIGUE_KEYS_TEXT) + "; with it "
-                                  "the run reports the SWT parameter under the contact, the crack-initiation life "
-                                  "over the wear history and the damage mode (2D; README); omitted: none", None)},
+        "fatigue": Key("fatigue", "opt-in fretting fatigue of this body (the flat; the moving body as a half-space "
+                                  "of its own, a cylinder whose contact half-width is at most a tenth of its "
+                                  "radius): the strain-life curve's constants, a mapping of "
+                                  + ", ".join(FATIGUE_KEYS_TEXT) + "; with it the run reports the body's SWT "
+                                  "parameter under the contact, its crack-initiation life over the wear history "
+                                  "and the damage mode (2D; README); omitted: none", None)},
     "loading": {
         "normal_load": Key("force", "normal load P (total, both in 2D and 3D)", REQUIRED,
                            plausible=(1e-6, 1e7, "1 µN to 10 MN"), example="185 N"),
@@ -283,8 +285,9 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "snapshots": Key("cycle_list", "cycles at which fields are written (+ the last); auto: 0, N/4, N/2, "
                                        "3N/4, N; with limits, quarters of the pilot's predicted stop (else the "
                                        "decades below N) and N", None),
-        "stresses": Key("flag", "with fatigue: also write the stationary body's stress components under the "
-                                "contact at the recorded states (/fields/stress_*); omitted: the SWT field only",
+        "stresses": Key("flag", "with fatigue: also write the stress components under the contact at the recorded "
+                                "states (/fields/stress_*, the moving body's /fields/stress_*_moving); omitted: "
+                                "the SWT field only",
                         False)},
 }
 SECTIONS = ("name", "geometry", "materials", "loading", "model", "solver", "jumping", "grid", "output", "limits",
@@ -1093,23 +1096,26 @@ def _scheme(jumping: dict, jumping_raw: dict) -> tuple[Optional[str], Optional[s
 
 
 def _check_fatigue(r: "_Reader", materials: dict, model: dict, mu: Optional[float], crack_limit, stresses) -> None:
-    """What fretting fatigue needs: the flat's constants (the moving body's half-space is not modelled yet) and a
-    friction coefficient (the shear traction drives the cracks); the crack limit and the stress output need the
-    constants."""
-    if any(path.startswith("materials.stationary.fatigue") for path, _ in r.problems):
+    """What fretting fatigue needs: either body's constants (the moving body's half-space is checked against the
+    contact's size by the plan; in 2D only so far), a friction coefficient (the shear traction drives the cracks);
+    the crack limit and the stress output need the constants."""
+    if any(path.startswith(("materials.stationary.fatigue", "materials.moving.fatigue")) for path, _ in r.problems):
         return  # (already said what is wrong with them)
-    given = {body for body, m in materials.items() if m.fatigue is not None}
-    if "moving" in given:
-        r.fail("materials.moving.fatigue", "the moving body's fatigue is not modelled yet (its stresses need its "
-                                           "own half-space); give the constants for materials.stationary")
-    if "stationary" not in given:
+    given = [body for body in ("stationary", "moving") if body in materials and materials[body].fatigue is not None]
+    if not given:
         for path, on in ((f"limits.{CRACK_LIMIT}", crack_limit), ("output.stresses", stresses)):
             if on:
-                r.fail(path, "needs materials.stationary.fatigue (the strain-life constants)")
+                r.fail(path, "needs materials.stationary.fatigue or materials.moving.fatigue (the strain-life "
+                             "constants)")
         return
+    where = f"materials.{given[0]}.fatigue"
     if mu is None or mu == 0:
-        r.fail("materials.stationary.fatigue", "fretting fatigue needs loading.friction_coefficient (> 0): the "
-                                               "shear traction is what opens the cracks")
+        r.fail(where, "fretting fatigue needs loading.friction_coefficient (> 0): the shear traction is what opens "
+                      "the cracks")
+    if model.get("dimension") != "2d" and "moving" in given:
+        r.fail("materials.moving.fatigue", "the moving body's fatigue is computed in plane strain only so far (in "
+                                           "3D the flat's is: give materials.stationary.fatigue); set "
+                                           "model.dimension: 2d")
 
 
 def _check_model(r: "_Reader", geometry, materials: dict, model: dict, mu: Optional[float]) -> None:

@@ -111,8 +111,9 @@ SUMMARY: dict[str, Figure] = {
     "time_to_limit_h": Figure("h", nan=True),  # ... or no loading.frequency
     "estimated_error_cycles_to_limit": Figure("1", nan=True),
     "grid_error_wall_time_s": Figure("s"),
-    # fretting fatigue of the flat (materials.stationary.fatigue; absent otherwise): the largest over the fatigue
-    # states, the crack-initiation cycle (NaN: beyond the run) and which damage comes first
+    # fretting fatigue of the flat (materials.stationary.fatigue; absent otherwise — damage_mode comes with either
+    # body's constants): the largest over the fatigue states, the crack-initiation cycle (NaN: beyond the run) and
+    # which damage comes first
     "max_shear_stress_MPa": Figure("MPa"),
     "max_shear_stress_depth_um": Figure("um"),
     "max_surface_tensile_stress_MPa": Figure("MPa"),
@@ -129,6 +130,20 @@ SUMMARY: dict[str, Figure] = {
     "fatigue_states_error": Figure("1", nan=True),  # the crack cycle's (or damage's) change with half the states
     "estimated_error_cycles_to_crack": Figure("1", nan=True),  # no crack in the run or its companion, or none run
     "estimated_error_swt_max": Figure("1", nan=True),
+    # the moving body's (materials.moving.fatigue; absent otherwise): the same figures on its own half-space,
+    # named as the flat's with _moving before the unit; damage_mode above counts both bodies' cracks
+    "max_shear_stress_moving_MPa": Figure("MPa"),
+    "max_shear_stress_depth_moving_um": Figure("um"),
+    "max_surface_tensile_stress_moving_MPa": Figure("MPa"),
+    "swt_max_moving_MPa": Figure("MPa"),
+    "swt_location_x_moving_mm": Figure("mm"),
+    "swt_depth_moving_um": Figure("um"),
+    "ruiz_max_moving": Figure("MPa^2*mm"),
+    "cycles_to_crack_initiation_moving": Figure("cycles", nan=True),
+    "crack_location_x_moving_mm": Figure("mm", nan=True),
+    "fatigue_damage_moving": Figure("1"),
+    "fatigue_states_error_moving": Figure("1", nan=True),
+    "crack_body": Figure(""),  # with fatigue: the body whose crack starts first, stationary or moving ("" none)
 }
 SUMMARY_WEAR = ("max_wear_depth_moving", "max_wear_depth_stationary", "centre_wear_depth_moving",
                 "centre_wear_depth_stationary", "scar_width_stationary", "scar_width_moving", "wear_volume_moving",

@@ -25,12 +25,11 @@ from fretsim.compliance import add
 from fretsim.cycle import Cycle, CycleError
 from fretsim.cycle.result import TRACTIONS
 from fretsim.errors import DomainError, NumericalFailure, PhysicalLimit, ResolutionError, SimulationError
-from fretsim.fatigue.damage import Miner, evaluate
 from fretsim.fatigue.damage import summary as fatigue_summary
 from fretsim.geometry import Limits
 from fretsim.grid import Grid
 from fretsim.loading import Loading
-from fretsim.loop import blocks, checkpoint, checks
+from fretsim.loop import blocks, checkpoint, checks, fatigue
 from fretsim.loop.landing import Landing, Reached
 from fretsim.quantities import wear_summary
 from fretsim.refine import coarsen, refine_pressure
@@ -80,6 +79,12 @@ class Setup:
     limit_tolerance: float = 1e-3  # relative: the crossing cycle of a limit is found to this
     frequency: Optional[float] = None  # Hz: the time to a limit
     fatigue: Optional[object] = None  # fretting fatigue of the flat (fretsim.fatigue.damage.FatigueSpec), opt-in
+    fatigue_moving: Optional[object] = None  # ... of the moving body (its own half-space), opt-in
+
+    @property
+    def fatigue_specs(self) -> tuple:
+        """The bodies' fatigue specs given (the flat's first): what the loop counts the damage of."""
+        return tuple(f for f in (self.fatigue, self.fatigue_moving) if f is not None)
 
     @property
     def solve_grid(self) -> Grid:
@@ -120,6 +125,7 @@ class Step:
     block: int = 0  # the loading's block whose cycles led to this state (0 at the start)
     limit: Optional[tuple] = None  # (key, crossing cycle, its interpolation spread): the wear limit reached here
     fatigue: Optional[object] = None  # the flat's fatigue at this state (fretsim.fatigue.damage.FatigueState)
+    fatigue_moving: Optional[object] = None  # the moving body's
     state: dict = field(default_factory=dict)  # the loop's checkpoint after this step (for resuming)
 
 
@@ -182,7 +188,7 @@ class _Loop:
         self.batch: list = []  # adaptive scheme: (wear m, wear s, work, energy) at the last linear steps
         self.watch = GrowthWatch()
         self._summed = (None, None, None)  # (extra, compliance, their sum) of the last implicit solve
-        self.miner = Miner() if setup.fatigue is not None else None  # the flat's fatigue damage so far
+        self.miners = fatigue.miners(setup)  # each body's fatigue damage so far (loop.fatigue)
 
     def restore(self, st: dict) -> None:
         checkpoint.restore(self, st)
@@ -258,12 +264,11 @@ class _Loop:
         if verdict == "reached":
             step.is_snapshot = True  # the state at the limit is what the engineer looks at
             step.limit = self.reached = self.landing.reached()
-        if self.miner is not None and self._fatigue(step):
-            crack = self.miner.crack[0]
-            if verdict != "reached" or crack < step.limit[1]:  # (the first crossing names the limit reached)
-                verdict = "reached"  # limits.crack_initiation: the run ends at the state where the damage reached 1
-                step.is_snapshot = True
-                step.limit = self.reached = ("crack_initiation", crack, self.n - crack, 1.0)
+        crack = fatigue.count(self, step) if self.miners else None
+        if crack is not None and (verdict != "reached" or crack[0] < step.limit[1]):  # (the first crossing names it)
+            verdict = "reached"  # limits.crack_initiation: the run ends at the state where the damage reached 1
+            step.is_snapshot = True
+            step.limit = self.reached = ("crack_initiation", crack[0], self.n - crack[0], 1.0)
         step.state = checkpoint.state(self)
         self.last_state = step.state
         for obs in self.observers:
@@ -276,43 +281,11 @@ class _Loop:
         return step
 
     def _fatigue_due(self, cycle: int) -> bool:
-        """Whether a step ending at ``cycle`` reaches the next fatigue state: the fatigue is evaluated at the first
-        step at or past each (the states are not stops: the stepping takes its own steps, each detailed as due)."""
-        if self.miner is None:
-            return False
-        if self.miner.damage is None or cycle in self.s.loading.boundaries:  # (a block's end: the rate jumps there)
-            return True
-        return cycle >= next((n for n in self.s.fatigue.states if n > self.miner.cycle), math.inf)
+        return fatigue.due(self, cycle)
 
     def fatigue_restart(self, cyc: Cycle) -> None:
         """A block's start: the new block's cycle at the same wear restarts Miner's sums (loop.blocks)."""
-        if self.miner is not None and cyc.tractions is not None:
-            s = self.s
-            self.miner.restart(self.n, self._evaluate(cyc, full=False))
-
-    def _fatigue(self, step: Step) -> bool:
-        """The flat's fatigue at a detailed state (or at a wear limit's, detailed now) added to Miner's sum; True
-        where it just reached 1 and the case stops there."""
-        s, cyc = self.s, step.cycle_result
-        if self.miner.damage is not None and self.n <= self.miner.cycle:
-            return False  # (a resumed run's first state: counted already)
-        if cyc.tractions is None:
-            if not step.is_snapshot:
-                return False
-            cyc = self.cycle_at(self.n, self.p, detail=True)
-        step.fatigue = self._evaluate(cyc, full=step.is_snapshot)
-        had = self.miner.crack is not None
-        self.miner.add(self.n, step.fatigue, s.grid.x, s.grid.y)
-        stop = s.fatigue.crack_limit and not had and self.miner.crack is not None
-        if stop and not step.fatigue.full:  # the run ends here: this state is recorded, with its fields in full
-            step.fatigue = self._evaluate(cyc)
-            self.miner.peak(step.fatigue)  # (its largest shear: the state's every layer)
-        return stop
-
-    def _evaluate(self, cyc: Cycle, full: bool = True):
-        s = self.s
-        return evaluate(s.fatigue, s.grid.x, s.grid.dx, s.fatigue.curve.youngs_modulus, cyc, full=full, y=s.grid.y,
-                        dy=s.grid.dy)
+        fatigue.restart(self, cyc)
 
     def restored_cycle(self) -> Cycle:
         """The cycle at the restored state: rebuilt from its pressure where the rates are linear in it, else solved
@@ -441,6 +414,5 @@ def summarize(setup: Setup, step: Step, solves: int, wall_time: float, max_error
         "cycles_to_limit": float(step.limit[1]) if step.limit else float("nan"),
         "time_to_limit_h": (float(step.limit[1]) / setup.frequency / 3600.0 if step.limit and setup.frequency
                             else float("nan")),
-        **(fatigue_summary(setup.fatigue, step.state, setup.grid.x, step.limit) if setup.fatigue is not None
-           else {}),
+        **(fatigue_summary(setup.fatigue_specs, step.state, step.limit) if setup.fatigue_specs else {}),
     }

@@ -234,8 +234,6 @@ def test_the_uniform_and_the_coulomb_cycle_give_the_same_swt_in_gross_slip():
 
 
 @pytest.mark.parametrize("override, where", [
-    ("materials.moving.fatigue={strength_coefficient: 2030 MPa, strength_exponent: -0.1, "
-     "ductility_coefficient: 0.8, ductility_exponent: -0.7}", "materials.moving.fatigue"),
     ("loading.friction_coefficient=null", "materials.stationary.fatigue"),
     ("materials.stationary.fatigue.strength_exponent=0.1", "materials.stationary.fatigue.strength_exponent"),
     ("materials.stationary.fatigue.critical_distance=25", "materials.stationary.fatigue.critical_distance"),
@@ -244,6 +242,24 @@ def test_what_fatigue_cannot_use_is_refused_with_its_key(override, where):
     with pytest.raises(CaseError) as exc:
         load_case(TI, [override])
     assert where in str(exc.value)
+
+
+MOVING = ("materials.moving.fatigue={strength_coefficient: 2464 MPa, strength_exponent: -0.1715, "
+          "ductility_coefficient: 0.0711, ductility_exponent: -0.6098, critical_distance: 25 um}")
+
+
+@pytest.mark.parametrize("overrides", [
+    ["model.dimension=3d"],  # with the flat's constants: both refused by the first key
+    ["model.dimension=3d", "materials.stationary.fatigue=null"],  # the moving body's alone: refused by its own
+    ["loading.friction_coefficient=null", "materials.stationary.fatigue=null"],
+    ["materials.moving.fatigue.strength_exponent=0.1"],
+])
+def test_what_the_moving_bodys_fatigue_cannot_use_is_refused_with_its_key(overrides):
+    with pytest.raises(CaseError) as exc:
+        load_case(TI, [MOVING] + overrides)
+    text = str(exc.value)
+    assert ("materials.moving.fatigue" in text if "materials.stationary.fatigue=null" in overrides or
+            "strength_exponent" in overrides[0] else "materials.stationary.fatigue" in text), text
 
 
 def test_the_crack_limit_and_the_stresses_need_the_constants_and_the_cli_says_so_in_a_paragraph(tmp_path):

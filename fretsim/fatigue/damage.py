@@ -1,5 +1,12 @@
-"""Fretting fatigue over the wear history: the flat's SWT field at each fatigue state, its crack-initiation life,
+"""Fretting fatigue over the wear history: each body's SWT field at each fatigue state, its crack-initiation life,
 and Miner's sum of the damage over the cycles as the wear changes the contact.
+
+Either body may be given constants (``materials.<body>.fatigue``).  The flat carries the moving body's tractions
+where the moving body is (ξ + s, :func:`history.on_flat`).  The moving body (a cylinder of radius R ≫ the contact
+half-width) is taken as a half-space of its own: it carries the pressure p and the opposite shear traction, −q,
+at its own points (no travel: the grid moves with it).  Mirrored through the contact plane (its depth pointing
+into it, x kept) its problem is the flat's with the shear's sign turned — the stress components in (x, depth)
+are those of :func:`history.stresses` under (p, −q), the critical plane's angle measured towards its own depth.
 
 At a fatigue state (a cycle the loop details: :data:`Setup.fatigue`'s ``states``) the cycle's tractions give the
 flat's stresses over the cycle (:mod:`.history`), the SWT parameter on each point's critical plane
@@ -30,7 +37,7 @@ LINEAR_STATES = 16  # ... and evenly over the run, where the contact evolves slo
 
 @dataclass(frozen=True)
 class FatigueSpec:
-    """What the loop needs for fatigue: the flat's curve and elastic constants, the depths, the states."""
+    """What the loop needs for one body's fatigue: its curve and elastic constants, the depths, the states."""
 
     curve: Basquin
     poisson: float
@@ -39,6 +46,7 @@ class FatigueSpec:
     states: tuple  # cycles at which the fatigue is evaluated (and the loop details the cycle)
     crack_limit: bool = False  # stop where the damage reaches 1
     keep_stresses: bool = False  # output.stresses
+    body: str = "stationary"  # whose: the flat's (the tractions at ξ + s) or the moving body's (−q at its points)
 
 
 def fatigue_states(last: int, snapshots: tuple) -> tuple:
@@ -100,22 +108,27 @@ def evaluate(spec: FatigueSpec, x: np.ndarray, dx: float, youngs: float, cyc, fu
     keep = _thinned(q, slid)
     p, q, travel = p[keep], q[keep], travel[keep]
     slid = {keep.index(k): m for k, m in slid.items()}  # (every sliding state is kept, and the one before it)
-    p_flat, q_flat = history.on_flat(p, travel, x, dx), history.on_flat(q, travel, x, dx)
-    p_flat, q_flat, slid = _distinct(p_flat, q_flat, slid)
-    cols = history.window(p_flat)
+    if spec.body == "moving":  # its own points: a rigid slide moves nothing on it; the flat pulls it by −q
+        p_on, q_on, slid = p, -q, {}
+        slip = cyc.slip_moving
+    else:
+        p_on, q_on = history.on_flat(p, travel, x, dx), history.on_flat(q, travel, x, dx)
+        slip = cyc.slip_stationary
+    p_on, q_on, slid = _distinct(p_on, q_on, slid)
+    cols = history.window(p_on)
     z = spec.depths
     nz, nx = len(z), len(x)
     layers = nz if full or spec.critical_distance is None else min(nz, int(np.searchsorted(z, spec.critical_distance)) + 1)
     swt, angle = np.zeros((nz, nx)), np.zeros((nz, nx))
     if cols.stop <= cols.start:
         return _state(spec, z, x, swt, angle, None, 0.0 if full else math.nan, 0.0, 0.0, 0.0, full)
-    st = history.stresses(p_flat[:, cols], q_flat[:, cols], dx, z[:layers])
+    st = history.stresses(p_on[:, cols], q_on[:, cols], dx, z[:layers])
     plane = swt_search((st.sxx, st.szz, st.sxz), youngs, spec.poisson, slid,
                        skip=0.0 if full else SKIP)
     swt[:layers, cols], angle[:layers, cols] = plane.swt, plane.angle
     tension = float(st.sxx[:, 0, :].max())  # (the surface layer: computed at every state)
-    slip_amplitude = 0.25 * np.asarray(cyc.slip_stationary)[0, cols]  # mm: a quarter of the cycle's slip
-    ruiz = np.maximum(st.sxx[:, 0, :].max(axis=0), 0.0) * np.abs(q_flat[:, cols]).max(axis=0) * slip_amplitude
+    slip_amplitude = 0.25 * np.asarray(slip)[0, cols]  # mm: a quarter of the cycle's slip
+    ruiz = np.maximum(st.sxx[:, 0, :].max(axis=0), 0.0) * np.abs(q_on[:, cols]).max(axis=0) * slip_amplitude
     shear_max, shear_depth, extremes = math.nan, math.nan, None
     if full:  # every layer: the largest shear (often deeper than the critical distance) and the stresses' range
         shear = np.hypot(0.5 * (st.sxx - st.szz), st.sxz).max(axis=0)  # (depth, x) over the cycle
@@ -308,43 +321,44 @@ class Miner:
         top = float(self.damage.max())
         return abs(top - float(half.max())) / top if top > 0 else 0.0
 
-    def to_state(self) -> dict:
-        """For the loop's checkpoint (flat arrays and numbers)."""
+    def to_state(self, prefix: str = "fatigue") -> dict:
+        """For the loop's checkpoint (flat arrays and numbers), its keys ``prefix``_…: one Miner per body."""
         if self.damage is None:
             return {}
         # (layers, y, x): the grid's (y, x) last, so that a widening of the grid pads them as it pads the wear (a
-        # line contact's one row restored: fatigue_dims 3 marks a 3D grid's)
+        # line contact's one row restored: dims 3 marks a 3D grid's)
         grid = (lambda a: a) if self.damage.ndim == 3 else (lambda a: a[:, None, :])  # noqa: E731
-        out = {"fatigue_damage": grid(self.damage), "fatigue_rate": grid(self.rate), "fatigue_cycle": self.cycle}
-        out.update({"fatigue_half": grid(self.half), "fatigue_half_rate": grid(self.half_rate),
-                    "fatigue_half_cycle": float(self.half_cycle), "fatigue_count": int(self.count)})
+        out = {"damage": grid(self.damage), "rate": grid(self.rate), "cycle": self.cycle,
+               "half": grid(self.half), "half_rate": grid(self.half_rate),
+               "half_cycle": float(self.half_cycle), "count": int(self.count)}
         if self.damage.ndim == 3:
-            out["fatigue_dims"] = 3
+            out["dims"] = 3
         if math.isfinite(self.half_crack):
-            out["fatigue_half_crack"] = float(self.half_crack)
+            out["half_crack"] = float(self.half_crack)
         if self.crack is not None:
-            out["fatigue_crack"] = np.array(self.crack, dtype=float)
+            out["crack"] = np.array(self.crack, dtype=float)
         for key, (value, where) in self.peaks.items():
-            out[f"fatigue_peak_{key}"] = np.array([value, *np.atleast_1d(where)], dtype=float)
-        return out
+            out[f"peak_{key}"] = np.array([value, *np.atleast_1d(where)], dtype=float)
+        return {f"{prefix}_{k}": v for k, v in out.items()}
 
     @classmethod
-    def from_state(cls, st: dict) -> "Miner":
-        if "fatigue_damage" not in st:
+    def from_state(cls, st: dict, prefix: str = "fatigue") -> "Miner":
+        if f"{prefix}_damage" not in st:
             return cls()
+        st = {k[len(prefix) + 1:]: v for k, v in st.items() if k.startswith(prefix + "_")}
         crack = None
-        if "fatigue_crack" in st:
-            crack = tuple(float(c) for c in np.asarray(st["fatigue_crack"], dtype=float))
+        if "crack" in st:
+            crack = tuple(float(c) for c in np.asarray(st["crack"], dtype=float))  # (cycle, x[, y in 3D])
         peaks = {}
         for key in ("max_shear", "max_tension", "ruiz_max", "swt_max"):
-            if f"fatigue_peak_{key}" in st:
-                v = [float(a) for a in np.atleast_1d(st[f"fatigue_peak_{key}"])]
+            if f"peak_{key}" in st:
+                v = [float(a) for a in np.atleast_1d(st[f"peak_{key}"])]
                 peaks[key] = (v[0], tuple(v[1:]) if len(v) > 2 else v[1])
-        grid = ((lambda a: np.asarray(a, dtype=float)) if int(st.get("fatigue_dims", 2)) == 3 else
+        grid = ((lambda a: np.asarray(a, dtype=float)) if int(st.get("dims", 2)) == 3 else
                 (lambda a: np.asarray(a, dtype=float)[:, 0, :]))  # noqa: E731
-        return cls(grid(st["fatigue_damage"]), grid(st["fatigue_rate"]), float(st["fatigue_cycle"]), crack, peaks,
-                   grid(st["fatigue_half"]), grid(st["fatigue_half_rate"]), float(st["fatigue_half_cycle"]),
-                   float(st.get("fatigue_half_crack", math.nan)), int(st["fatigue_count"]))
+        return cls(grid(st["damage"]), grid(st["rate"]), float(st["cycle"]), crack, peaks, grid(st["half"]),
+                   grid(st["half_rate"]), float(st["half_cycle"]), float(st.get("half_crack", math.nan)),
+                   int(st["count"]))
 
 
 def _rate(state: FatigueState) -> np.ndarray:
@@ -376,17 +390,42 @@ def damage_mode(crack_cycle: float, wear_limit_cycle: float) -> str:
     return "wear" if wear else "none"
 
 
-def summary(spec: FatigueSpec, state: dict, x: np.ndarray, limit: Optional[tuple]) -> dict:
-    """The summary's fatigue figures from a step's checkpoint (``Step.state``) and the limit it stopped at."""
-    miner = Miner.from_state(state)
+PREFIX = {"stationary": "fatigue", "moving": "fatigue_moving"}  # each body's Miner in the checkpoint
+UNITS = ("_MPa", "_mm", "_um")
+
+
+def keyed(key: str, body: str) -> str:
+    """A per-body summary key: the flat's as it always was, the moving body's with ``_moving`` before the unit
+    (as max_wear_depth_moving_um)."""
+    if body == "stationary":
+        return key
+    unit = next((u for u in UNITS if key.endswith(u)), "")
+    return f"{key[:len(key) - len(unit)]}_moving{unit}"
+
+
+def summary(specs: tuple, state: dict, limit: Optional[tuple]) -> dict:
+    """The summary's fatigue figures of each body with constants (``specs``) from a step's checkpoint
+    (``Step.state``) and the limit it stopped at; the damage mode and the body whose crack starts first of both."""
+    out, first = {}, (math.inf, "")
+    for spec in specs:
+        figures = _body_summary(Miner.from_state(state, PREFIX[spec.body]))
+        crack = figures["cycles_to_crack_initiation"]
+        if math.isfinite(crack) and crack < first[0]:
+            first = (crack, spec.body)
+        out.update({keyed(k, spec.body): v for k, v in figures.items()})
+    wear_limit = limit[1] if limit is not None and limit[0] != "crack_initiation" else math.nan
+    out["damage_mode"] = damage_mode(first[0], wear_limit)
+    out["crack_body"] = first[1]
+    return out
+
+
+def _body_summary(miner: Miner) -> dict:
     nan = float("nan")
     peak = lambda key: miner.peaks.get(key, (nan, nan))  # noqa: E731
     swt, where = peak("swt_max")[0], (tuple(peak("swt_max")[1]) if "swt_max" in miner.peaks else (nan, nan))
     swt_x, swt_z = where[:2]
-    crack = miner.crack[0] if miner.crack is not None else nan
-    wear_limit = limit[1] if limit is not None and limit[0] != "crack_initiation" else nan
     across = {}
-    if len(where) == 3 or int(state.get("fatigue_dims", 2)) == 3:  # 3D: where across the stroke, too
+    if len(where) == 3 or (miner.damage is not None and miner.damage.ndim == 3):  # 3D: where across the stroke
         across = {"swt_location_y_mm": where[2] if len(where) == 3 else nan,
                   "crack_location_y_mm": miner.crack[2] if miner.crack is not None else nan}
     return {
@@ -397,10 +436,9 @@ def summary(spec: FatigueSpec, state: dict, x: np.ndarray, limit: Optional[tuple
         "swt_location_x_mm": swt_x,
         "swt_depth_um": swt_z * 1e3,
         "ruiz_max": peak("ruiz_max")[0],
-        "cycles_to_crack_initiation": crack,
+        "cycles_to_crack_initiation": miner.crack[0] if miner.crack is not None else nan,
         "crack_location_x_mm": miner.crack[1] if miner.crack is not None else nan,
         "fatigue_damage": float(miner.damage.max()) if miner.damage is not None else nan,
-        "damage_mode": damage_mode(crack, wear_limit),
         "fatigue_states_error": miner.states_error(),
         **across,
     }

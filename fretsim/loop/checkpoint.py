@@ -10,7 +10,7 @@ import time
 
 import numpy as np
 
-from fretsim.fatigue.damage import Miner
+from fretsim.loop import fatigue
 from fretsim.stability import GrowthWatch
 
 # the loop's own attributes, written as they are
@@ -42,8 +42,7 @@ def state(loop) -> dict:
         st["limit_key"], st["limit_cycle"], st["limit_spread"], st["limit_exponent"] = loop.reached
     for k, v in loop.memory.items():
         st["memory_" + k] = v
-    if loop.miner is not None:
-        st.update(loop.miner.to_state())
+    st.update(fatigue.to_state(loop))
     return st
 
 
@@ -71,8 +70,7 @@ def restore(loop, st: dict) -> None:
     loop.last_state = st  # a checkpoint is the state of the step written last: a retake goes back to it
     _restore_limits(loop, st)
     _restore_memory(loop, st)
-    if loop.s.fatigue is not None:
-        loop.miner = Miner.from_state(st)
+    fatigue.restore(loop, st)
     loop.watch = GrowthWatch(np.atleast_1d(st.get("watch", [])))
     loop.cyc = None  # rebuilt only if needed (a run resumed at its end)
     if "r_m" not in st:  # a checkpoint of format 1.2, which only had uniform slip: the rates follow from p

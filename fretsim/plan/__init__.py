@@ -22,7 +22,7 @@ import dataclasses
 import functools
 from typing import Optional
 
-from fretsim.case import Case
+from fretsim.case import Case, CaseError
 from fretsim.fatigue.damage import FatigueSpec, fatigue_states
 from fretsim.fatigue.history import depths
 from fretsim.fatigue.swt import Basquin
@@ -93,29 +93,64 @@ def _setup(case: Case, plan: Plan, grids, operators, regime, cycles, steps, cont
                  coarse_gap=operators.coarse_gap, per_cycle=steps.per_cycle,
                  gross_slip_stroke=regime.transition if regime.transition is not None else float("nan"),
                  regime_block=regime.block if regime.transition is not None else None,
-                 notes=_notes(plan), fatigue=_fatigue(case, grids.grid, steps.snapshots, contact))
+                 notes=_notes(plan), **_fatigue(case, grids.grid, steps.snapshots, contact))
 
 
-def _fatigue(case: Case, grid, snapshots: tuple, contact) -> Optional[FatigueSpec]:
-    """The flat's fatigue, where the case gives its constants: the curve (its endurance limit, a stress amplitude,
-    as the SWT σ_e²/E it stands for), the depths — to four unworn Hertz half-widths and the stroke's reach twice,
-    the region the moving load sweeps, fixed for the run so that the damage adds up at the same points — and
-    the states (those on the way to each recorded state's end)."""
-    flat = case.stationary
-    f = flat.fatigue
-    if f is None:
-        return None
-    e = flat.youngs_modulus
-    curve = Basquin(f.strength_coefficient, f.strength_exponent, f.ductility_coefficient, f.ductility_exponent, e,
-                    endurance_limit=None if f.endurance_limit is None else f.endurance_limit ** 2 / e)
+HALF_SPACE = 0.1  # the moving body's fatigue: the largest unworn contact half-width a/R its half-space may take
+
+
+def _fatigue(case: Case, grid, snapshots: tuple, contact) -> dict:
+    """Each body's fatigue, where the case gives its constants ({"fatigue": the flat's, "fatigue_moving": the
+    moving body's}): the curve (its endurance limit, a stress amplitude, as the SWT σ_e²/E it stands for), the
+    depths — to four unworn Hertz half-widths and the stroke's reach twice, the region the moving load sweeps,
+    fixed for the run so that the damage adds up at the same points, and the same for both bodies (one /fields/z)
+    — and the states (those on the way to each recorded state's end)."""
+    given = {body: m for body, m in (("stationary", case.stationary), ("moving", case.moving))
+             if m.fatigue is not None}
+    if not given:
+        return {}
     deepest = 4.0 * contact.hertz.half_width_x + 2.0 * case.loading.peak_stroke
-    if f.critical_distance is not None:
-        deepest = max(deepest, 2.0 * f.critical_distance)
+    for m in given.values():
+        if m.fatigue.critical_distance is not None:
+            deepest = max(deepest, 2.0 * m.fatigue.critical_distance)
+    if "moving" in given:
+        _check_half_space(case, contact.hertz.half_width_x, deepest)
     ends = {case.loading.cycles} | {max(snapshots, default=0)}
-    states = sorted(set().union(*(fatigue_states(n, snapshots) for n in ends)))
-    return FatigueSpec(curve=curve, poisson=flat.poissons_ratio, depths=depths(grid.dx, deepest),
-                       critical_distance=f.critical_distance, states=tuple(states), crack_limit=case.crack_limit,
-                       keep_stresses=case.output_stresses)
+    states = tuple(sorted(set().union(*(fatigue_states(n, snapshots) for n in ends))))
+    out = {}
+    for body, m in given.items():
+        f, e = m.fatigue, m.youngs_modulus
+        curve = Basquin(f.strength_coefficient, f.strength_exponent, f.ductility_coefficient, f.ductility_exponent,
+                        e, endurance_limit=None if f.endurance_limit is None else f.endurance_limit ** 2 / e)
+        out["fatigue" if body == "stationary" else "fatigue_moving"] = FatigueSpec(
+            curve=curve, poisson=m.poissons_ratio, depths=depths(grid.dx, deepest),
+            critical_distance=f.critical_distance, states=states, crack_limit=case.crack_limit,
+            keep_stresses=case.output_stresses, body=body)
+    return out
+
+
+def _check_half_space(case: Case, half_width: float, deepest: float) -> None:
+    """The moving body's stresses are a half-space's: refused where its shape is clearly not one.  A cylinder's
+    surface leaves the plane by x²/2R; over the field the stresses are computed on (|x| ≲ 2a, the depths to
+    ``deepest``) that is of order a/R of the contact's own scale, and Hertz's theory, whose pressure the run
+    starts from, has the same O(a/R) error: beyond a/R = HALF_SPACE the two are no longer small.  A cylinder held
+    closer above the contact than the depths reach, or a tube (its wall bends as a ring: a bending stress under
+    the contact that no half-space carries) is refused as well."""
+    g = case.geometry
+    radius = getattr(g, "radius", None)
+    problem = None
+    if radius is None:
+        problem = (f"a {g.kind}'s moving body is not a half-space (a tube's wall bends as a ring under the "
+                   f"contact); fretsim computes the moving body's fatigue for a cylinder_on_flat only")
+    elif half_width > HALF_SPACE * radius:
+        problem = (f"the unworn contact's half-width {half_width * 1e3:.4g} µm is {half_width / radius:.3g} of the "
+                   f"cylinder's radius {radius:.4g} mm, above {HALF_SPACE:g}: its stresses are not a half-space's "
+                   f"(the half-space approximation's error is of order a/R)")
+    elif getattr(g, "moving_height", None) is not None and g.moving_height < deepest:
+        problem = (f"the cylinder is held {g.moving_height:.4g} mm above the contact, less than the "
+                   f"{deepest:.4g} mm the fatigue's depths reach: its stresses there are not a half-space's")
+    if problem is not None:
+        raise CaseError(case.source, [("materials.moving.fatigue", problem)])
 
 
 def _notes(plan: Plan) -> tuple:

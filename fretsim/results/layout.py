@@ -82,6 +82,22 @@ STRESSES = {
     f"stress_{c}_{end}": ("MPa", f"the stationary body's stress σ_{c} below its surface: its {end}imum over the cycle",
                           lambda f, i=2 * i + j: f.stresses[i])
     for i, c in enumerate(("xx", "zz", "xz")) for j, end in enumerate(("max", "min"))}
+# the moving body's (materials.moving.fatigue), on its own grid (the grid moves with it) and the same depths,
+# below its surface: its depth points into it, x as the flat's.  Absent without its constants.
+SUBSURFACE_MOVING = {
+    "swt_moving": ("MPa", "Smith-Watson-Topper parameter on the critical plane below the moving body's surface "
+                          "(its half-space, at its own points)", lambda f: f.swt),
+    "swt_plane_angle_moving": ("deg", "the moving body's critical plane's normal, from the sliding direction x "
+                                      "towards its depth", lambda f: np.degrees(f.angle)),
+}
+STRESSES_MOVING = {
+    f"stress_{c}_{end}_moving": ("MPa", f"the moving body's stress σ_{c} below its surface (x, its depth): its "
+                                        f"{end}imum over the cycle", lambda f, i=2 * i + j: f.stresses[i])
+    for i, c in enumerate(("xx", "zz", "xz")) for j, end in enumerate(("max", "min"))}
+# each body's subsurface tables: (SWT fields, stresses), and the Step's attribute holding its fatigue state
+SUBSURFACE_BODIES = {"stationary": (SUBSURFACE, STRESSES, "fatigue"),
+                     "moving": (SUBSURFACE_MOVING, STRESSES_MOVING, "fatigue_moving")}
+SUBSURFACE_TABLES = {**SUBSURFACE, **SUBSURFACE_3D, **STRESSES, **SUBSURFACE_MOVING, **STRESSES_MOVING}
 FIELDS_V12 = [k for k in FIELDS if not k.startswith(("slip_distance", "shear"))]
 NAN_FIELDS = {"shear_traction"}  # the uniform model without a friction coefficient does not know it
 SUMMARY_UNITS = {key: figure.unit for key, figure in SUMMARY.items()}

@@ -17,7 +17,7 @@ import numpy as np
 from fretsim.errors import ResultsFileError
 from fretsim.results.layout import (FIELDS, FIELDS_V12, FORMAT_VERSION, HISTORY, HISTORY_V11, HISTORY_V12, HISTORY_V13,
                                     HISTORY_V14, MAX_DATASET_BYTES, NAN_FIELDS, NAN_HISTORY, NAN_SUMMARY,
-                                    READABLE_FORMATS, STATUSES, STRESSES, SUBSURFACE, SUBSURFACE_3D,
+                                    READABLE_FORMATS, STATUSES, SUBSURFACE_TABLES,
                                     in_summary_order)
 from fretsim.results.seal import (SEALED_FROM, _SCALE_ATTRS, _Damaged, _verify_attrs_seal, _verify_seal,
                                   checkpoint_digest, plain, text, verify_image)
@@ -43,7 +43,18 @@ class Results:
     inputs: dict = field(default_factory=dict)  # name: (value, units)
     overrides: list = field(default_factory=list)
     regrids: list = field(default_factory=list)  # the automatic grid's widenings (fretsim.regrid.Regrid), in order
-    subsurface: dict = field(default_factory=dict)  # fretting fatigue: z (mm), fields (cycle, z, [y,] x) below the flat
+    subsurface: dict = field(default_factory=dict)  # fretting fatigue: z (mm) and fields (cycle, z, [y,] x) below
+    #                                                  the flat (swt, …) and the moving body (swt_moving, …): see fatigue()
+
+    def fatigue(self, body: str = "stationary") -> dict:
+        """One body's fields below its surface, by their plain names (z, swt, swt_plane_angle, stress_…), or {}
+        where the run had no fatigue constants for it: ``body`` "stationary" (the flat) or "moving"."""
+        from fretsim.results.layout import SUBSURFACE_3D, SUBSURFACE_BODIES
+        swt, stresses, _ = SUBSURFACE_BODIES[body]
+        suffix = "_moving" if body == "moving" else ""
+        names = (*swt, *stresses, *(SUBSURFACE_3D if body == "stationary" else ()))
+        out = {k[:len(k) - len(suffix)]: self.subsurface[k] for k in names if k in self.subsurface}
+        return {"z": self.subsurface["z"], **out} if out else {}
 
     @property
     def status(self) -> str:
@@ -159,8 +170,10 @@ class Results:
                                                                  "long_name": "cycle of the accepted step"})}
         data = {k: (("cycle", "y", "x"), v, {"units": self.units.get(f"fields/{k}", "")})
                 for k, v in self.fields.items() if k != "cycle"}
-        if self.subsurface:  # fretting fatigue: the flat's fields below its surface
-            coords["z"] = ("z", self.subsurface["z"], {"units": "mm", "long_name": "depth below the flat's surface"})
+        if self.subsurface:  # fretting fatigue: each body's fields below its surface (the moving body's …_moving)
+            said = {frozenset({"swt"}): "the flat's", frozenset({"swt_moving"}): "the moving body's"}.get(
+                frozenset({"swt", "swt_moving"} & set(self.subsurface)), "each body's")
+            coords["z"] = ("z", self.subsurface["z"], {"units": "mm", "long_name": f"depth below {said} surface"})
             data.update({k: (("cycle", "z", "x") if v.ndim == 3 else ("cycle", "z", "y", "x"), v,
                              {"units": self.units.get(f"fields/{k}", "")})
                          for k, v in self.subsurface.items() if k != "z"})
@@ -365,8 +378,8 @@ def _read_fields(f, version: str, shape: tuple, units: dict) -> dict:
 
 
 def _read_subsurface(f, snapshots: int, grid: tuple, units: dict) -> dict:
-    """Fretting fatigue's depths and fields below the flat (cycle, z, x), or (cycle, z, y, x) on a 3D grid; NaN where
-    a state had none evaluated."""
+    """Fretting fatigue's depths and fields below each body with constants (cycle, z, x; the moving body's named
+    ``…_moving``), over (cycle, z, y, x) on a 3D grid; NaN where a state had none evaluated."""
     ny, nx = grid
     z = _dataset(f, "fields/z", 1)
     if not z.size or not (z > 0).all() or (z.size > 1 and not (np.diff(z) > 0).all()):
@@ -374,7 +387,7 @@ def _read_subsurface(f, snapshots: int, grid: tuple, units: dict) -> dict:
     out = {"z": z}
     units["fields/z"] = "mm"
     across = () if ny == 1 else (ny,)
-    for k in (*SUBSURFACE, *SUBSURFACE_3D, *STRESSES):
+    for k in SUBSURFACE_TABLES:
         if k in f["fields"]:
             out[k] = _dataset(f, f"fields/{k}", 3 + len(across), shape=(snapshots, z.size, *across, nx),
                               allow_nan=True)

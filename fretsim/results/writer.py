@@ -19,7 +19,7 @@ import h5py
 import numpy as np
 
 from fretsim import __version__
-from fretsim.results.layout import FIELDS, FORMAT_VERSION, STRESSES, SUBSURFACE, SUBSURFACE_3D, HISTORY, INTEGER_HISTORY, SUMMARY_UNITS, summary_long_name
+from fretsim.results.layout import FIELDS, FORMAT_VERSION, SUBSURFACE_3D, SUBSURFACE_BODIES, SUBSURFACE_TABLES, HISTORY, INTEGER_HISTORY, SUMMARY_UNITS, summary_long_name
 from fretsim.results.seal import USERBLOCK, _SealingWriter, checkpoint_digest, seal_image
 from fretsim.results.reader import Results
 
@@ -79,8 +79,8 @@ class ResultsWriter:
             self.field_cycles.append(step.cycle)
             for name, (_, _, get) in FIELDS.items():
                 self.fields[name].append(np.array(get(step)))
-            if setup.fatigue is not None:
-                self._add_subsurface(setup, step)
+            if setup.fatigue_specs:
+                _add_subsurface(self, setup, step)
             loop = step.cycle_result.loop
             self.loops.append((loop[0] * 1e3, loop[1]) if loop is not None else (np.zeros(0), np.zeros(0)))
         self.state = step.state
@@ -93,16 +93,6 @@ class ResultsWriter:
         # a flush rebuilds the whole file (tens of ms): never let flushing take more than ~5 % of a long run
         if now - self._flushed > max(FLUSH_SECONDS, FLUSH_COST_FACTOR * self._flush_cost):
             self.flush()
-
-    def _add_subsurface(self, setup, step) -> None:
-        """The flat's fields below its surface at a snapshot (NaN where the state had no fatigue evaluated)."""
-        self.depths = setup.fatigue.depths
-        tables = {**SUBSURFACE, **(SUBSURFACE_3D if setup.grid.shape[0] > 1 else {}),
-                  **(STRESSES if setup.fatigue.keep_stresses else {})}
-        for name, (_, _, get) in tables.items():
-            shape = (len(self.depths),) + setup.grid.shape
-            value = np.asarray(get(step.fatigue)) if step.fatigue is not None else np.full(shape, np.nan)
-            self.subsurface.setdefault(name, []).append(value.reshape(shape))
 
     def regrid(self, r, grid, case_yaml: str, choices, notes) -> None:
         """The run moved onto a widened grid (:mod:`fretsim.regrid`): the snapshots so far are padded onto it (the
@@ -266,14 +256,28 @@ class ResultsWriter:
                 case_file=str(self.inputs.get("case_file", "")))
 
 
+def _add_subsurface(writer: "ResultsWriter", setup, step) -> None:
+    """Each body's fields below its surface at a snapshot (NaN where the state had no fatigue evaluated)."""
+    writer.depths = setup.fatigue_specs[0].depths  # (the bodies share them)
+    for spec in setup.fatigue_specs:
+        swt, stresses, attribute = SUBSURFACE_BODIES[spec.body]
+        state = getattr(step, attribute)
+        across = SUBSURFACE_3D if setup.grid.shape[0] > 1 and spec.body == "stationary" else {}  # (3D: the flat)
+        for name, (_, _, get) in {**swt, **across, **(stresses if spec.keep_stresses else {})}.items():
+            shape = (len(writer.depths),) + setup.grid.shape
+            value = np.asarray(get(state)) if state is not None else np.full(shape, np.nan)
+            writer.subsurface.setdefault(name, []).append(value.reshape(shape))
+
+
 def _write_subsurface(writer: "ResultsWriter", w: "_SealingWriter", fl, scales: list) -> None:
     """/fields/z and the fatigue fields over (cycle, z, x): a line contact's y (one row) dropped; over (cycle, z, y,
     x) in 3D."""
     z = w.dataset(fl, "z", np.asarray(writer.depths, dtype=float), units="mm",
-                  long_name="depth below the stationary body's surface")
+                  long_name="depth below the stationary body's surface" if "swt" in writer.subsurface else
+                  "depth below the moving body's surface")
     z.make_scale("z")
     for name, values in writer.subsurface.items():
-        units, long_name, _ = {**SUBSURFACE, **SUBSURFACE_3D, **STRESSES}[name]
+        units, long_name, _ = SUBSURFACE_TABLES[name]
         data = np.array(values, dtype=float)
         rows = data.shape[2]
         data = data.reshape(len(values), len(writer.depths), -1) if rows == 1 else data
