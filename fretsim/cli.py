@@ -456,24 +456,35 @@ def _limits(s: dict, c) -> str:
 
 
 def _fatigue(s: dict, c) -> str:
-    """The fretting-fatigue sentence: when and where a crack starts (or the damage reached), and what comes first."""
-    import math
-    if c.stationary.fatigue is None or "damage_mode" not in s:
+    """The fretting-fatigue sentence: when and where a crack starts in each body with constants (or the damage
+    reached), and what comes first."""
+    if "damage_mode" not in s:
         return ""
-    n, err = s["cycles_to_crack_initiation"], s.get("estimated_error_cycles_to_crack", float("nan"))
-    crit = c.stationary.fatigue.critical_distance
-    where = (f"the largest point SWT {s['swt_max_MPa']:.3g} MPa at x = {s['swt_location_x_mm'] * 1e3:.4g} µm, "
-             f"{s['swt_depth_um']:.3g} µm deep" + (f"; the damage counts its mean over the {crit * 1e3:.3g} µm below "
+    bodies = [(body, m.fatigue) for body, m in (("stationary", c.stationary), ("moving", c.moving))
+              if m.fatigue is not None]
+    text = ". ".join(_body_fatigue(s, body, f, len(bodies) > 1) for body, f in bodies)
+    stopped = s.get("limit_reached") == "crack_initiation"
+    return (f" {text}; damage mode: {s['damage_mode']}" + (f" (the run stopped at the {s.get('crack_body')} body's "
+                                                           f"crack)." if stopped else "."))
+
+
+def _body_fatigue(s: dict, body: str, f, both: bool) -> str:
+    import math
+    from fretsim.fatigue.damage import keyed
+    v = lambda key: s.get(keyed(key, body), float("nan"))  # noqa: E731
+    n = v("cycles_to_crack_initiation")
+    err = s.get("estimated_error_cycles_to_crack", float("nan")) if body == "stationary" else float("nan")
+    crit = f.critical_distance
+    where = (f"the largest point SWT {v('swt_max_MPa'):.3g} MPa at x = {v('swt_location_x_mm') * 1e3:.4g} µm, "
+             f"{v('swt_depth_um'):.3g} µm deep" + (f"; the damage counts its mean over the {crit * 1e3:.3g} µm below "
                                                    f"each surface point" if crit else ""))
+    head = "Fretting fatigue" + (f" of the {'flat' if body == 'stationary' else 'moving body'}" if both or
+                                 body == "moving" else "")
     if math.isfinite(n):
-        text = (f" Fretting fatigue: a crack starts at cycle {n:,.0f}" + (f" (± {err:.1e} relative)" if
-                                                                          math.isfinite(err) else "")
-                + f" at x = {s['crack_location_x_mm'] * 1e3:.4g} µm ({where})")
-    else:
-        text = (f" Fretting fatigue: no crack within the run (Miner's sum reached {s['fatigue_damage']:.3g} of 1; "
-                f"{where})")
-    return text + f"; damage mode: {s['damage_mode']}" + (" (the run stopped there)." if s.get("limit_reached") ==
-                                                          "crack_initiation" else ".")
+        return (f"{head}: a crack starts at cycle {n:,.0f}" + (f" (± {err:.1e} relative)" if math.isfinite(err)
+                                                               else "")
+                + f" at x = {v('crack_location_x_mm') * 1e3:.4g} µm ({where})")
+    return (f"{head}: no crack within the run (Miner's sum reached {v('fatigue_damage'):.3g} of 1; {where})")
 
 
 def _said(outcome) -> str:
@@ -548,10 +559,10 @@ def check(case_file: Path, overrides: tuple, debug: bool) -> None:
     click.echo(f"explicit stability limit: {setup.stability_limit:.4g} cycles (solve grid, gap model {filled.gap_model})")
     if loading.friction_coefficient is not None:
         click.echo(_check_regime(setup, loading))
-    if setup.fatigue is not None:
-        f = setup.fatigue
+    for f in setup.fatigue_specs:
         line = "line method over " + f"{f.critical_distance * 1e3:.3g} µm" if f.critical_distance else "point values"
-        click.echo(f"fretting fatigue: the flat's SWT on the critical plane ({line}) at {len(f.states)} fatigue "
+        whose = "the flat's" if f.body == "stationary" else "the moving body's (its own half-space)"
+        click.echo(f"fretting fatigue: {whose} SWT on the critical plane ({line}) at {len(f.states)} fatigue "
                    f"states, {len(f.depths)} depths to {f.depths[-1] * 1e3:.3g} µm; Miner's sum over the wear history"
                    + ("; the run stops where it reaches 1" if f.crack_limit else ""))
     from fretsim.runner import estimate

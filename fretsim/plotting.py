@@ -266,8 +266,9 @@ def _builders(res: Results, log_cycles: bool) -> dict:
         out["fretting"] = lambda: _fretting(res)
     if _dissipates(res.history):  # a run with a friction coefficient (format 1.5 on)
         out["energy_wear"] = lambda: _energy_wear(res)
-    if res.subsurface.get("swt") is not None and res.subsurface["swt"].size:
-        out["fatigue"] = lambda: _fatigue(res)
+    for body, name in (("stationary", "fatigue"), ("moving", "fatigue_moving")):  # each body's, where it has one
+        if res.fatigue(body).get("swt") is not None and res.fatigue(body)["swt"].size:
+            out[name] = lambda body=body: _fatigue(res, body)
     return out
 
 
@@ -953,11 +954,17 @@ def _fretting(res: Results):
 # --- fretting fatigue: the SWT field under the contact, and a sweep's life against the stroke ---------------------
 
 
-def _fatigue(res: Results):
-    """The stationary body's SWT field below its surface at the recorded state where it peaks (the peak over the
-    run and where the crack starts marked); the hot spot at true scale with the critical plane's trace at each
-    point; and the field's peak at each recorded state against cycles, with the crack cycle."""
-    sub, summary = res.subsurface, res.summary
+def _fatigue(res: Results, body: str = "stationary"):
+    """One body's SWT field below its surface at the recorded state where it peaks (the peak over the run and
+    where the crack starts marked); the hot spot at true scale with the critical plane's trace at each point; and
+    the field's peak at each recorded state against cycles, with the crack cycle.  The moving body's is drawn at
+    its own points, depth into it."""
+    from fretsim.fatigue.damage import keyed
+    sub = res.fatigue(body)
+    summary = {k: res.summary.get(keyed(k, body), np.nan) for k in (
+        "cycles_to_crack_initiation", "crack_location_x_mm", "swt_location_x_mm", "swt_depth_um", "swt_max_MPa",
+        "fatigue_damage")}
+    summary["damage_mode"] = res.summary.get("damage_mode", "–")
     swt, angle, z = sub["swt"], sub["swt_plane_angle"], sub["z"] * 1e3  # depths in µm
     peaks = np.array([np.nanmax(f) if np.isfinite(f).any() else np.nan for f in swt])
     k = int(np.nanargmax(peaks)) if np.isfinite(peaks).any() else len(peaks) - 1
@@ -972,17 +979,16 @@ def _fatigue(res: Results):
     if top > 0:
         _swt_overview(axes[0], fig, field, x, z, top, summary)
         _hot_spot(axes[1], field, plane, x, z, top)
-    axes[0].set_title(f"stationary body, {_cycles_label(res.fields['cycle'][k])}{where}: SWT on the critical plane",
+    axes[0].set_title(f"{body} body, {_cycles_label(res.fields['cycle'][k])}{where}: SWT on the critical plane",
                       **({"fontsize": 10} if where else {}))
     ax = axes[2]
     ax.plot(res.fields["cycle"], peaks, "o-", ms=4, label="SWT peak at each recorded state")
-    crack = summary.get("cycles_to_crack_initiation", np.nan)
+    crack = summary["cycles_to_crack_initiation"]
     if np.isfinite(crack):
         ax.axvline(crack, color="b", ls="--", lw=1.0, label="crack starts")
     ax.set_xlabel("cycles")
-    ax.set_ylabel(f"SWT peak ({_unit(res, 'fields/swt')})")
-    ax.set_title(f"damage {summary.get('fatigue_damage', np.nan):.3g} of 1 at the end; {summary.get('damage_mode', '–')}",
-                 fontsize=10)
+    ax.set_ylabel(f"SWT peak ({_unit(res, 'fields/swt' if body == 'stationary' else 'fields/swt_moving')})")
+    ax.set_title(f"damage {summary['fatigue_damage']:.3g} of 1 at the end; {summary['damage_mode']}", fontsize=10)
     ax.legend(fontsize=8)
     ax.grid(alpha=0.3)
     return fig

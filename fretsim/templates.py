@@ -88,11 +88,12 @@ def case_reference_markdown() -> str:
               "(blocks) or fraction (spectrum, of loading.cycles), and friction_coefficient where it differs; "
               "with blocks, loading.normal_load and loading.stroke are not given |"]
     for key, spec in FATIGUE_SCHEMA.items():
-        lines.append(f"| `materials.stationary.fatigue.{key}` | {_unit(spec)} | {_default(spec)} | {_allowed(spec)} | "
-                     f"{spec.help} |")
-    lines.append("| `limits.crack_initiation` | – | false | true, false | with materials.stationary.fatigue: the run "
-                 "stops at the fatigue state where Miner's sum first reaches 1, and reports limit_reached "
-                 "crack_initiation and cycles_to_crack_initiation |")
+        lines.append(f"| `materials.{{moving,stationary}}.fatigue.{key}` | {_unit(spec)} | {_default(spec)} | "
+                     f"{_allowed(spec)} | {spec.help} |")
+    lines.append("| `limits.crack_initiation` | – | false | true, false | with materials.stationary.fatigue or "
+                 "materials.moving.fatigue: the run stops at the fatigue state where either body's Miner's sum "
+                 "first reaches 1, and reports limit_reached crack_initiation, cycles_to_crack_initiation (the "
+                 "moving body's: cycles_to_crack_initiation_moving) and crack_body, the body that cracked |")
     for key, spec in LIMITS_SCHEMA.items():
         lines.append(f"| `limits.{key}` | {_unit(spec)} | {_default(spec)} | {_allowed(spec)} | a wear limit: "
                      f"{spec.help}; the run stops where the first limit is reached and reports limit_reached, "

@@ -79,7 +79,7 @@ def _fatigue_seconds(setup, op, gap, solves: int) -> float:
     tractions, the flat's stresses and the plane search), times the states the run will evaluate — the fatigue
     states up to its cycles, at most one a step, and the recorded states in full.  The worn contact is wider than
     the unworn: a low estimate, as the solves' own."""
-    if setup.fatigue is None:
+    if not setup.fatigue_specs:
         return 0.0
     from fretsim.cycle.result import TRACTIONS
     from fretsim.fatigue.damage import evaluate
@@ -90,11 +90,13 @@ def _fatigue_seconds(setup, op, gap, solves: int) -> float:
     if cyc.tractions is None:
         return 0.0
     cycle_s = time.perf_counter() - t
-    args = (setup.fatigue, setup.grid.x, setup.grid.dx, setup.fatigue.curve.youngs_modulus, cyc)
-    grid = {"y": setup.grid.y, "dy": setup.grid.dy}
-    evaluate(*args, full=False, **grid)  # (the first pays scipy's imports and the depths' kernels, once a run)
-    t = time.perf_counter()
-    evaluate(*args, full=False, **grid)
-    one = cycle_s * WARM_SOLVE + time.perf_counter() - t
-    states = sum(1 for n in setup.fatigue.states if n <= setup.cycles)
+    one = cycle_s * WARM_SOLVE
+    for spec in setup.fatigue_specs:  # each body's stresses and plane search
+        args = (spec, setup.grid.x, setup.grid.dx, spec.curve.youngs_modulus, cyc)
+        grid = {"y": setup.grid.y, "dy": setup.grid.dy}
+        evaluate(*args, full=False, **grid)  # (the first pays scipy's imports and the depths' kernels, once a run)
+        t = time.perf_counter()
+        evaluate(*args, full=False, **grid)
+        one += time.perf_counter() - t
+    states = sum(1 for n in setup.fatigue_specs[0].states if n <= setup.cycles)
     return one * min(states, max(solves, 1)) + 3.0 * one * len(setup.snapshots)  # (a recorded state: every layer)
