@@ -470,7 +470,7 @@ def _fatigue(s: dict, c) -> str:
 
 def _body_fatigue(s: dict, body: str, f, both: bool) -> str:
     import math
-    from fretsim.fatigue.damage import keyed
+    from fretsim.quantities import keyed
     v = lambda key: s.get(keyed(key, body), float("nan"))  # noqa: E731
     n = v("cycles_to_crack_initiation")
     err = s.get("estimated_error_cycles_to_crack", float("nan")) if body == "stationary" else float("nan")

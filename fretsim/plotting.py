@@ -959,7 +959,7 @@ def _fatigue(res: Results, body: str = "stationary"):
     where the crack starts marked); the hot spot at true scale with the critical plane's trace at each point; and
     the field's peak at each recorded state against cycles, with the crack cycle.  The moving body's is drawn at
     its own points, depth into it."""
-    from fretsim.fatigue.damage import keyed
+    from fretsim.quantities import keyed
     sub = res.fatigue(body)
     summary = {k: res.summary.get(keyed(k, body), np.nan) for k in (
         "cycles_to_crack_initiation", "crack_location_x_mm", "swt_location_x_mm", "swt_depth_um", "swt_max_MPa",

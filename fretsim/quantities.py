@@ -173,3 +173,12 @@ def unit_of(summary_key: str) -> str:
 def wear_summary(step, x) -> dict:
     """The summary's wear figures of a state, in their reported units."""
     return {WEAR[k].summary_key: WEAR[k].measure(step, x, None) * WEAR[k].factor for k in SUMMARY_WEAR}
+
+
+def keyed(key: str, body: str) -> str:
+    """A per-body fatigue summary key: the flat's as it always was, the moving body's with ``_moving`` before the
+    unit (as max_wear_depth_moving_um)."""
+    if body == "stationary":
+        return key
+    unit = next((u for u in ("_MPa", "_mm", "_um") if key.endswith(u)), "")
+    return f"{key[:len(key) - len(unit)]}_moving{unit}"

@@ -30,6 +30,7 @@ import numpy as np
 
 from fretsim.fatigue import history
 from fretsim.fatigue.swt import Basquin, swt_search
+from fretsim.quantities import keyed
 
 STATES_PER_DECADE = 6  # fatigue states on the way up (geometric): the damage rate changes fastest early
 LINEAR_STATES = 16  # ... and evenly over the run, where the contact evolves slowly
@@ -391,17 +392,6 @@ def damage_mode(crack_cycle: float, wear_limit_cycle: float) -> str:
 
 
 PREFIX = {"stationary": "fatigue", "moving": "fatigue_moving"}  # each body's Miner in the checkpoint
-UNITS = ("_MPa", "_mm", "_um")
-
-
-def keyed(key: str, body: str) -> str:
-    """A per-body summary key: the flat's as it always was, the moving body's with ``_moving`` before the unit
-    (as max_wear_depth_moving_um)."""
-    if body == "stationary":
-        return key
-    unit = next((u for u in UNITS if key.endswith(u)), "")
-    return f"{key[:len(key) - len(unit)]}_moving{unit}"
-
 
 def summary(specs: tuple, state: dict, limit: Optional[tuple]) -> dict:
     """The summary's fatigue figures of each body with constants (``specs``) from a step's checkpoint
