@@ -289,7 +289,7 @@ def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from:
                                 f"resume with `fretsim run --resume {output}`")
         raise
     setup, filled, plan = sink.setup, sink.filled, sink.plan  # (on the grid the run ended on)
-    if counter.last is not None and setup.fatigue is not None:
+    if counter.last is not None and setup.fatigue_specs:
         _yield_note(filled, _summary(setup, counter, t0), counter)
     if status == "complete" and counter.last is not None:
         _estimate_errors(setup, filled, plan, counter, sink, t0, runs)
@@ -411,16 +411,19 @@ def _estimate_errors(setup, filled, plan, counter, sink: _Sink, t0, runs: SideRu
 
 
 def _yield_note(filled: Case, summary: dict, counter: "_Counter") -> None:
-    """A fatigue run whose flat's largest shear stress passes Tresca's yield (σ_y/2, with the flat's yield strength
-    given): said, since the elastic stresses there, and the SWT life from them, are beyond the model's range (a
-    worn partial-slip contact concentrates its pressure on the stick zone's edge)."""
-    sy = filled.stationary.yield_strength
-    shear = summary.get("max_shear_stress_MPa", float("nan"))
-    if sy is not None and math.isfinite(shear) and shear > 0.5 * sy:
-        counter.notes.append(f"the flat's largest shear stress {shear:.4g} MPa (at a recorded state, "
-                             f"{summary['max_shear_stress_depth_um']:.3g} µm deep) passes Tresca's yield σ_y/2 = "
-                             f"{0.5 * sy:.4g} MPa: the flat yields there, where the elastic stresses and the "
-                             f"fatigue life from them do not follow it (the life is the elastic model's)")
+    """A fatigue run whose body's largest shear stress passes Tresca's yield (σ_y/2, with that body's yield
+    strength given): said, since the elastic stresses there, and the SWT life from them, are beyond the model's
+    range (a worn partial-slip contact concentrates its pressure on the stick zone's edge)."""
+    from fretsim.quantities import keyed
+    for body, m, whose in (("stationary", filled.stationary, "the flat's"),
+                           ("moving", filled.moving, "the moving body's")):
+        sy, shear = m.yield_strength, summary.get(keyed("max_shear_stress_MPa", body), float("nan"))
+        if sy is not None and math.isfinite(shear) and shear > 0.5 * sy:
+            counter.notes.append(f"{whose} largest shear stress {shear:.4g} MPa (at a recorded state, "
+                                 f"{summary[keyed('max_shear_stress_depth_um', body)]:.3g} µm deep) passes Tresca's "
+                                 f"yield σ_y/2 = {0.5 * sy:.4g} MPa: {whose[:-2]} yields there, where the elastic "
+                                 f"stresses and the fatigue life from them do not follow it (the life is the "
+                                 f"elastic model's)")
 
 
 def _ignore_signals() -> dict:

@@ -6,7 +6,8 @@
   curve, and Ruiz's fretting damage parameter.
 * :mod:`.stresses3d` — the same for the 3D half-space on a grid (rectangles by FFT); :func:`.swt.swt_3d` in 3D
   (not wired into the loop: a 3D fatigue case is refused);
-* :mod:`.history` — a cycle's tractions laid on the flat and its stresses over the cycle (by FFT);
-* :mod:`.damage` — the fatigue states, each state's SWT field and life, and Miner's sum over the wear history
-  (what the loop, :mod:`fretsim.simulate`, calls).
+* :mod:`.history` — a cycle's tractions laid on the flat and its stresses over the cycle (by FFT); the moving
+  body's, at its own points under (p, −q), by the same convolution (:mod:`.damage`);
+* :mod:`.damage` — the fatigue states, each body's SWT field and life at each, and Miner's sum over the wear
+  history (what the loop, :mod:`fretsim.loop.fatigue`, calls).
 """

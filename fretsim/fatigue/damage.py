@@ -393,6 +393,7 @@ def damage_mode(crack_cycle: float, wear_limit_cycle: float) -> str:
 
 PREFIX = {"stationary": "fatigue", "moving": "fatigue_moving"}  # each body's Miner in the checkpoint
 
+
 def summary(specs: tuple, state: dict, limit: Optional[tuple]) -> dict:
     """The summary's fatigue figures of each body with constants (``specs``) from a step's checkpoint
     (``Step.state``) and the limit it stopped at; the damage mode and the body whose crack starts first of both."""
