@@ -464,8 +464,9 @@ def _fatigue(s: dict, c) -> str:
               if m.fatigue is not None]
     text = ". ".join(_body_fatigue(s, body, f, len(bodies) > 1) for body, f in bodies)
     stopped = s.get("limit_reached") == "crack_initiation"
-    return (f" {text}; damage mode: {s['damage_mode']}" + (f" (the run stopped at the {s.get('crack_body')} body's "
-                                                           f"crack)." if stopped else "."))
+    whose = {"stationary": "at the flat's crack", "moving": "at the moving body's crack"}.get(s.get("crack_body"), "")
+    where = whose if len(bodies) > 1 and whose else "there"
+    return f" {text}; damage mode: {s['damage_mode']}" + (f" (the run stopped {where})." if stopped else ".")
 
 
 def _body_fatigue(s: dict, body: str, f, both: bool) -> str:
