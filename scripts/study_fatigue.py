@@ -9,6 +9,7 @@ life against the stroke with wear and without.
 
     python scripts/study_fatigue.py            # → scripts/results/fatigue_states.txt
     python scripts/study_fatigue.py --cost     # the cost table alone, printed (not written)
+    python scripts/study_fatigue.py --cost-3d  # 3D: the ball with the flat's fatigue → scripts/results/fatigue_3d_cost.txt
 """
 from __future__ import annotations
 
@@ -72,9 +73,43 @@ def _cost() -> list:
     return lines
 
 
+BALL = ROOT / "cases" / "ball_partial_slip.yaml"
+TI_FLAT = ("materials.stationary.fatigue={strength_coefficient: 2464 MPa, strength_exponent: -0.1715, "
+           "ductility_coefficient: 0.0711, ductility_exponent: -0.6098, critical_distance: 20 um}")
+COST_3D = (("20 N, 0.7 um (partial slip)", []), ("200 N, 5 um (partial slip)", ["loading.normal_load=200 N",
+                                                                               "loading.stroke=5 um"]),
+           ("20 N, 5 um (gross slip)", ["loading.stroke=5 um"]))
+
+
+def _cost_3d() -> list:
+    """3D: the ball on a flat (cases/ball_partial_slip.yaml, 2·10⁴ cycles) with the flat's fatigue against the same
+    without, median of 3, in turn."""
+    lines = ["", "cost in 3D: cases/ball_partial_slip.yaml (2·10⁴ cycles) with the flat's Ti-6Al-4V constants "
+                 "against the same without, median of 3, in turn (grid.error_estimate none)"]
+    for name, extra in COST_3D:
+        with_f, without = [], []
+        for _ in range(3):
+            for fatigue, out in (((TI_FLAT,), with_f), ((), without)):
+                case = load_case(str(BALL), ["grid.error_estimate=none", *extra, *fatigue])
+                with tempfile.TemporaryDirectory() as tmp:
+                    t = time.perf_counter()
+                    res = run(case, Path(tmp) / "r.h5")
+                    out.append(time.perf_counter() - t)
+        a, b = sorted(with_f)[1], sorted(without)[1]
+        lines.append(f"  {name:30s}: with {a:.2f} s, without {b:.2f} s, ratio {a / b:.2f} "
+                     f"({res.summary['elements_x']} × {res.summary['elements_y']} elements)")
+    return lines
+
+
 def main() -> None:
     if "--cost" in sys.argv:
         print("\n".join(_cost()))
+        return
+    if "--cost-3d" in sys.argv:
+        text = "\n".join(_cost_3d()) + "\n"
+        print(text)
+        (ROOT / "scripts" / "results" / "fatigue_3d_cost.txt").write_text(
+            f"command: python scripts/study_fatigue.py --cost-3d ({time.strftime('%Y-%m-%d')})\n{text}")
         return
     lines = [__doc__.split("\n\n")[0], "", f"case {CASE.name}; grid.error_estimate none", "",
              "stroke   states/decade linear   crack cycle   damage at end   vs densest   estimated   run s   solves"]

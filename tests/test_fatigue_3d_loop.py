@@ -198,3 +198,12 @@ def test_a_3d_run_interrupted_with_fatigue_resumes_to_the_same_damage_and_crack(
                 "crack_location_y_mm", "swt_location_y_mm"):
         assert resumed.summary[key] == whole.summary[key] or (math.isnan(resumed.summary[key])
                                                               and math.isnan(whole.summary[key])), key
+
+
+def test_the_moving_bodys_fatigue_in_3d_is_refused_with_its_key_and_the_flats_is_not():
+    from fretsim.case import CaseError
+    moving = TI_FLAT.replace("materials.stationary.fatigue", "materials.moving.fatigue")
+    with pytest.raises(CaseError) as exc:
+        load_case(BALL, [moving])
+    assert "materials.moving.fatigue" in str(exc.value) and "model.dimension: 2d" in str(exc.value)
+    assert load_case(BALL, [TI_FLAT]).stationary.fatigue is not None
