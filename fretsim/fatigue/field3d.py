@@ -8,9 +8,9 @@ rectangles' closed forms by FFT, each depth's kernels made once for all the cycl
 point's best where it matters (:func:`.swt.swt_search_3d`).
 
 A state the contact reached by sliding rigidly over m elements passed every position between: those positions'
-stresses are the slid state's shifted back by 1 … m − 1 elements along x (the same tractions on a uniform grid),
-added to the history as states of their own — exact, like the 2D search's sliding windows, and no stress
-computed twice.
+stresses are the slid state's shifted by 1 … m − 1 elements along x (the same tractions on a uniform grid), which
+the plane search takes as sliding windows (:func:`.swt.swt_search_3d`) — exact, like the 2D search's, and no
+stress computed twice.
 
 In 3D the search skips points whose bound (:func:`.swt.bound_3d`) is below SKIP_3D of the field's peak at every
 state, the recorded ones too: the window's deep, far layers are most of its points and carry nothing; the
@@ -62,8 +62,7 @@ def fields_3d(spec, x: np.ndarray, dx: float, dy: float, youngs: float, traction
     if cols.stop <= cols.start:
         return Fields3D(swt, angle, azimuth, None, 0.0 if full else math.nan, 0.0, 0.0, 0.0)
     st = stress_history(p_flat[:, rows, cols], q_flat[:, rows, cols], dx, dy, z[:layers], spec.poisson)
-    st = _with_slides(st, slid)
-    plane = swt_search_3d(st, youngs, spec.poisson, skip=SKIP_3D if full else skip_between, full=full)
+    plane = swt_search_3d(st, youngs, spec.poisson, skip=SKIP_3D if full else skip_between, full=full, slides=slid)
     swt[:layers, rows, cols] = plane.swt
     angle[:layers, rows, cols], azimuth[:layers, rows, cols] = plane_angles(plane.normal)
     sxx_surface = st[0, :, 0]  # (state, y, x): the surface layer, computed at every state
@@ -99,22 +98,6 @@ def _window(pressure: np.ndarray) -> tuple:
         return slice(0, 0), slice(0, 0)
     pad = max(4, int(np.ceil(MARGIN_Y * (loaded[-1] - loaded[0] + 1))))
     return slice(max(0, int(loaded[0]) - pad), min(ny, int(loaded[-1]) + pad + 1)), cols
-
-
-def _with_slides(st: np.ndarray, slid: dict) -> np.ndarray:
-    """The history (6, state, depth, y, x) with every position a rigid slide passed: state k's field shifted back
-    towards state k − 1's by 1 … |m| − 1 elements (0 where it comes from beyond the window)."""
-    extra = []
-    for k, m in slid.items():
-        for j in range(1, abs(m)):
-            shift = -j if m > 0 else j
-            moved = np.zeros_like(st[:, k])
-            if shift < 0:
-                moved[..., :shift] = st[:, k, ..., -shift:]
-            else:
-                moved[..., shift:] = st[:, k, ..., :-shift]
-            extra.append(moved)
-    return np.concatenate([st, np.stack(extra, axis=1)], axis=1) if extra else st
 
 
 def _tresca(st: np.ndarray) -> np.ndarray:

@@ -439,34 +439,122 @@ def bound_3d(history, youngs: float, poisson: float) -> np.ndarray:
     return np.maximum(upper.max(axis=0), 0.0) * 0.5 * (e_hi - e_lo)
 
 
-def swt_search_3d(history, youngs: float, poisson: float, skip: float = 0.0, full: bool = True) -> CriticalPlane3D:
+def swt_search_3d(history, youngs: float, poisson: float, skip: float = 0.0, full: bool = True,
+                  slides: Optional[dict] = None) -> CriticalPlane3D:
     """:func:`swt_3d` to a fraction of a degree at a fraction of a dense search's cost: COARSE_NORMALS, then, where
-    they found at least REFINE_SHARE_3D of the peak (FINE_SHARE where ``full``: a recorded state's field), three
-    grids of normals about each point's best (CONES).  With ``skip`` > 0, points whose :func:`bound_3d` is below
-    ``skip`` of the peak are not searched (0 there): the peak is taken first over the PILOT_POINTS of the largest
-    bound, which no skipped point can then exceed."""
+    they found at least REFINE_SHARE_3D of the peak (FINE_SHARE where ``full``: a recorded state's field), grids of
+    normals about each point's best (CONES).  With ``skip`` > 0, points whose :func:`bound_3d` is below ``skip``
+    of the peak are not searched (0 there): the peak is taken first over the PILOT_POINTS of the largest bound,
+    which no skipped point can then exceed.
+
+    ``slides`` {state k: m}: states reached by sliding rigidly over m elements of the last axis since the state
+    before, so that on the way the field at a point was state k's at 0 … |m| − 1 elements further on: the first
+    pass takes each plane's extremes over that window (log₂ m comparisons), the cones and the pilot the points'
+    gathered histories — exact, however long the slide, for about the cost of the states themselves."""
     s = history if isinstance(history, np.ndarray) and history.shape[0] == 6 else _components(history)
     shape = s.shape[2:]
-    flat = s.reshape(6, s.shape[1], -1)
-    points = flat.shape[2]
+    nx = shape[-1] if shape else 1
+    rows = s.reshape(6, s.shape[1], -1, nx)  # (6, time, row, x): the slides run along x
+    slides = {k: m for k, m in (slides or {}).items() if abs(m) > 1}
+    points = rows.shape[2] * nx
     best, normal = np.zeros(points), np.tile([0.0, 0.0, 1.0], (points, 1))
     search = np.arange(points)
     coarse_normals = hemisphere_normals(COARSE_NORMALS)
     if skip > 0 and points:
-        bound = bound_3d(flat, youngs, poisson)
+        bound = _slid_bound(rows, slides, youngs, poisson).ravel()
         pilot = np.argsort(bound)[::-1][:PILOT_POINTS]
-        peak = float(_best_over(flat[:, :, pilot], coarse_normals, youngs, poisson, CHUNK)[0].max(initial=0.0))
+        peak = float(_best_over(_gathered(rows, slides, pilot), coarse_normals, youngs, poisson, CHUNK)[0].max(
+            initial=0.0))
         search = np.flatnonzero(bound >= skip * peak) if peak > 0 else np.zeros(0, int)
     if search.size:
-        part = flat if search.size == points else flat[:, :, search]
-        best[search], normal[search] = _best_over(part, coarse_normals, youngs, poisson, CHUNK)
+        best[search], normal[search] = _coarse_rows(rows, slides, search, coarse_normals, youngs, poisson)
         found = best[search]
         fine = search[found >= (FINE_SHARE if full else REFINE_SHARE_3D) * found.max()]
         for half, count in CONES:
             for lo in range(0, fine.size, CHUNK // (count * count)):
                 part = fine[lo:lo + CHUNK // (count * count)]
-                best[part], normal[part] = _cone(flat[:, :, part], normal[part], youngs, poisson, half, count)
+                best[part], normal[part] = _cone(_gathered(rows, slides, part), normal[part], youngs, poisson, half,
+                                                 count)
     return CriticalPlane3D(best.reshape(shape), normal.reshape(shape + (3,)))
+
+
+def _window(a: np.ndarray, m: int, pick) -> np.ndarray:
+    """``pick`` (np.maximum or np.minimum) of ``a`` over the |m| positions 0 … |m| − 1 elements on along the last
+    axis (towards +x for m > 0, −x for m < 0; positions beyond the array left out): log₂ |m| comparisons."""
+    out = np.array(a[..., ::-1] if m < 0 else a, copy=True)
+    span, width = 1, abs(m)
+    while span < width:
+        step = min(span, width - span)
+        pick(out[..., :-step], out[..., step:].copy(), out=out[..., :-step])
+        span += step
+    return out[..., ::-1] if m < 0 else out
+
+
+def _slid_bound(rows: np.ndarray, slides: dict, youngs: float, poisson: float) -> np.ndarray:
+    """:func:`bound_3d` over the states and every position their slides passed (rows (6, time, row, x))."""
+    sxx, syy, szz = rows[0], rows[1], rows[2]
+    axy, axz, ayz = np.abs(rows[3]), np.abs(rows[4]), np.abs(rows[5])
+    rx, ry, rz = axy + axz, axy + ayz, axz + ayz
+    upper = np.maximum(np.maximum(sxx + rx, syy + ry), szz + rz)
+    lower = np.minimum(np.minimum(sxx - rx, syy - ry), szz - rz)
+    trace = sxx + syy + szz
+    e_hi, e_lo = (1.0 + poisson) * upper - poisson * trace, (1.0 + poisson) * lower - poisson * trace
+    for k, m in slides.items():
+        upper[k], e_hi[k] = _window(upper[k], m, np.maximum), _window(e_hi[k], m, np.maximum)
+        e_lo[k] = _window(e_lo[k], m, np.minimum)
+    return np.maximum(upper.max(axis=0), 0.0) * 0.5 * (e_hi.max(axis=0) - e_lo.min(axis=0)) / youngs
+
+
+def _gathered(rows: np.ndarray, slides: dict, points: np.ndarray) -> np.ndarray:
+    """The histories (6, time, point) of the flat indices ``points``: the states, then each slide's positions on
+    the way (a position beyond the row repeats the last one inside: an extreme over a set is not changed by a
+    repeat)."""
+    nx = rows.shape[-1]
+    r, x = np.divmod(points, nx)
+    parts = [rows[:, :, r, x]]
+    for k, m in slides.items():
+        j = np.arange(1, abs(m)) * (1 if m > 0 else -1)
+        at = np.clip(x[None, :] + j[:, None], 0, nx - 1)  # (position, point)
+        parts.append(rows[:, k][:, r[None, :], at])
+    return np.ascontiguousarray(np.concatenate(parts, axis=1))
+
+
+def _coarse_rows(rows: np.ndarray, slides: dict, search: np.ndarray, normals: np.ndarray, youngs: float,
+                 poisson: float) -> tuple:
+    """The first pass over the rows holding searched points, a few rows at a time: each plane's normal stress and
+    strain per state, a slid state's over its window (:func:`_window`), their extremes over the history."""
+    n = normals / np.linalg.norm(normals, axis=1, keepdims=True)
+    weights = np.stack([n[:, 0] ** 2, n[:, 1] ** 2, n[:, 2] ** 2, 2 * n[:, 0] * n[:, 1], 2 * n[:, 0] * n[:, 2],
+                        2 * n[:, 1] * n[:, 2]])
+    nx = rows.shape[-1]
+    wanted = np.unique(search // nx)
+    group = max(1, CHUNK // (nx * len(n)))
+    value_at, where_at = np.zeros(rows.shape[2] * nx), np.zeros(rows.shape[2] * nx, dtype=int)
+    a, b = (1.0 + poisson) / youngs, poisson / youngs
+    for lo in range(0, wanted.size, group):
+        r = wanted[lo:lo + group]
+        top = high = low = None
+        for t in range(rows.shape[1]):
+            block = rows[:, t][:, r]  # (6, rows, x)
+            sn = (block.reshape(6, -1).T @ weights).reshape(r.size, nx, len(n))
+            en = a * sn - (b * (block[0] + block[1] + block[2]))[..., None]
+            s_top, e_high, e_low = sn, en, en
+            if t in slides:  # the window along x: move it to the last axis and back
+                m = slides[t]
+                s_top = np.moveaxis(_window(np.moveaxis(sn, 1, -1), m, np.maximum), -1, 1)
+                e_high = np.moveaxis(_window(np.moveaxis(en, 1, -1), m, np.maximum), -1, 1)
+                e_low = np.moveaxis(_window(np.moveaxis(en, 1, -1), m, np.minimum), -1, 1)
+            if top is None:
+                top, high, low = s_top.copy(), e_high.copy(), e_low.copy()
+            else:
+                np.maximum(top, s_top, out=top)
+                np.maximum(high, e_high, out=high)
+                np.minimum(low, e_low, out=low)
+        value = (np.maximum(top, 0.0) * 0.5 * (high - low)).reshape(-1, len(n))
+        flat = (r[:, None] * nx + np.arange(nx)[None, :]).ravel()
+        where_at[flat] = np.argmax(value, axis=1)
+        value_at[flat] = value[np.arange(value.shape[0]), where_at[flat]]
+    return value_at[search], n[where_at[search]]
 
 
 CHUNK = 40_000  # points × normals at a time: the work arrays stay in the cache (a quarter of the time of 4·10⁶)
