@@ -177,3 +177,43 @@ def _close_figures():
     import sys
     if "matplotlib.pyplot" in sys.modules:
         sys.modules["matplotlib.pyplot"].close("all")
+
+
+class StopAt:
+    """An observer that interrupts a run, as Ctrl-C would, at its first step at or past ``cycle``."""
+
+    def __init__(self, cycle: int):
+        self.cycle = cycle
+
+    def on_step(self, setup, step):
+        if step.cycle >= self.cycle:
+            raise KeyboardInterrupt
+
+
+def interrupted_and_resumed(case_path, overrides: list, cycle: int, out):
+    """The case run into ``out``, interrupted at ``cycle`` (:class:`StopAt`), then resumed: the resumed outcome."""
+    from fretsim.api import load_case, resume, run
+    with pytest.raises(KeyboardInterrupt):
+        run(load_case(case_path, overrides), out, observers=(StopAt(cycle),))
+    return resume(out)
+
+
+def same(a, b) -> bool:
+    """Equal, or both NaN (a figure a run does not reach)."""
+    return a == b or (a != a and b != b)
+
+
+@pytest.fixture
+def underestimated(monkeypatch):
+    """The automatic grid sized for a thirtieth of the worn volume the run will reach (so that it is widened);
+    the real sizing returned, to put back."""
+    import fretsim.plan.grid as plan_grid
+    real = plan_grid.auto_grid
+
+    def small(*args, **kw):
+        if kw.get("volume") is not None:
+            kw["volume"] = kw["volume"] / 30
+        return real(*args, **kw)
+
+    monkeypatch.setattr(plan_grid, "auto_grid", small)
+    return real

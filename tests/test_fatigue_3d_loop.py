@@ -9,7 +9,7 @@ from types import SimpleNamespace
 import numpy as np
 import pytest
 
-from fretsim.api import load_case, resume, run
+from fretsim.api import load_case, run
 from fretsim.fatigue import history
 from fretsim.fatigue.damage import FatigueSpec, evaluate
 from fretsim.fatigue.field3d import plane_angles
@@ -17,6 +17,8 @@ from fretsim.fatigue.stresses3d import COMPONENTS, half_space_stresses, stress_h
 from fretsim.fatigue.swt import Basquin, bound_3d, hemisphere_normals, swt_3d, swt_search_3d
 from fretsim.plotting import figures
 from fretsim.results import read_results
+
+from conftest import interrupted_and_resumed, same
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
 BALL = str(CASES / "ball_partial_slip.yaml")
@@ -184,20 +186,10 @@ def test_a_3d_file_holds_the_fields_over_cycle_depth_y_x_and_exports_and_draws_t
 def test_a_3d_run_interrupted_with_fatigue_resumes_to_the_same_damage_and_crack(tmp_path):
     case = CRACKING + ["loading.cycles=150", "output.snapshots=[0, 150]"]
     whole = run(load_case(BALL, case))
-
-    class Stop:
-        def on_step(self, setup, step):
-            if step.cycle >= 40:
-                raise KeyboardInterrupt
-
-    out = tmp_path / "r.h5"
-    with pytest.raises(KeyboardInterrupt):
-        run(load_case(BALL, case), out, observers=(Stop(),))
-    resumed = resume(out)
+    resumed = interrupted_and_resumed(BALL, case, 40, tmp_path / "r.h5")
     for key in ("cycles_to_crack_initiation", "fatigue_damage", "swt_max_MPa", "crack_location_x_mm",
                 "crack_location_y_mm", "swt_location_y_mm"):
-        assert resumed.summary[key] == whole.summary[key] or (math.isnan(resumed.summary[key])
-                                                              and math.isnan(whole.summary[key])), key
+        assert same(resumed.summary[key], whole.summary[key]), key
 
 
 def test_the_moving_bodys_fatigue_in_3d_is_refused_with_its_key_and_the_flats_is_not():
@@ -210,27 +202,19 @@ def test_the_moving_bodys_fatigue_in_3d_is_refused_with_its_key_and_the_flats_is
 
 
 @pytest.mark.slow
-def test_a_3d_fatigue_run_whose_grid_is_widened_matches_one_on_the_wide_grid_from_the_start(monkeypatch):
+def test_a_3d_fatigue_run_whose_grid_is_widened_matches_one_on_the_wide_grid_from_the_start(underestimated, monkeypatch):
     """The seat on a rail with the flat's constants on an automatic grid sized for a thirtieth of its wear: widened
     along x and along y during the run, its damage (kept per surface point, padded with the wear) and its SWT peak
     equal the run on the final grid from the start — to 1e-6 and 1e-5 (the stresses' windows, and so their
     FFTs' lengths, differ between the two grids: round-off, which can tip the plane search between two nearly
     equal normals of its grids; measured 6e-8 and 1e-6)."""
     import fretsim.plan.grid as plan_grid
-    real = plan_grid.auto_grid
-
-    def small(*args, **kw):
-        if kw.get("volume") is not None:
-            kw["volume"] = kw["volume"] / 30
-        return real(*args, **kw)
-
-    monkeypatch.setattr(plan_grid, "auto_grid", small)
     sets = ["grid.error_estimate=none", "loading.cycles=400", "loading.friction_coefficient=0.5", TI_FLAT]
     out = run(load_case(CASES / "seat_rail.yaml", sets))
     widened = " ".join(n for n in out.notes if "widened" in n)
     assert "widened along x" in widened and "widened along y" in widened
     g = out.setup.grid
-    monkeypatch.setattr(plan_grid, "auto_grid", real)
+    monkeypatch.setattr(plan_grid, "auto_grid", underestimated)
     wide = run(load_case(CASES / "seat_rail.yaml", sets + [
         f"grid.domain=[{g.shape[1] * g.dx!r} mm, {g.shape[0] * g.dy!r} mm]", f"grid.elements=[{g.shape[1]}, {g.shape[0]}]"]))
     assert out.summary["fatigue_damage"] == pytest.approx(wide.summary["fatigue_damage"], rel=1e-6)

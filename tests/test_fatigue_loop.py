@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 from click.testing import CliRunner
 
-from fretsim.api import load_case, resume, run
+from fretsim.api import load_case, run
 from fretsim.case import CaseError
 from fretsim.cli import main
 from fretsim.fatigue import history
@@ -17,6 +17,8 @@ from fretsim.fatigue.damage import FatigueSpec, FatigueState, Miner, damage_para
 from fretsim.fatigue.stresses import strip_stresses
 from fretsim.fatigue.swt import FINE_SHARE, Basquin, swt_2d, swt_search
 from fretsim.results import read_results
+
+from conftest import interrupted_and_resumed
 
 CASES = Path(__file__).resolve().parent.parent / "cases"
 TI = str(CASES / "ti_fretting_fatigue.yaml")
@@ -210,15 +212,7 @@ def test_the_results_file_holds_the_swt_field_over_cycle_depth_x_and_the_stresse
 def test_a_run_interrupted_with_fatigue_resumes_to_the_same_damage_and_crack(tmp_path):
     whole = run(load_case(TI, SHORT))
 
-    class Stop:
-        def on_step(self, setup, step):
-            if step.cycle >= 2000:
-                raise KeyboardInterrupt
-
-    out = tmp_path / "r.h5"
-    with pytest.raises(KeyboardInterrupt):
-        run(load_case(TI, SHORT), out, observers=(Stop(),))
-    resumed = resume(out)
+    resumed = interrupted_and_resumed(TI, SHORT, 2000, tmp_path / "r.h5")
     for key in ("cycles_to_crack_initiation", "fatigue_damage", "swt_max_MPa", "crack_location_x_mm"):
         assert resumed.summary[key] == whole.summary[key], key
 

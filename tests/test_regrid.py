@@ -18,20 +18,6 @@ COULOMB = ["model.dimension=2d", "grid.error_estimate=none", "loading.friction_c
            "model.slip=coulomb", "model.stroke=mid_stroke"]
 
 
-@pytest.fixture
-def underestimated(monkeypatch):
-    """The automatic grid sized for a thirtieth of the worn volume the run will reach."""
-    real = plan_grid.auto_grid
-
-    def small(*args, **kw):
-        if kw.get("volume") is not None:
-            kw["volume"] = kw["volume"] / 30
-        return real(*args, **kw)
-
-    monkeypatch.setattr(plan_grid, "auto_grid", small)
-    return real
-
-
 def _given(grid) -> list[str]:
     return [f"grid.domain=[{grid.shape[1] * grid.dx!r} mm]", f"grid.elements=[{grid.shape[1]}]"]
 
