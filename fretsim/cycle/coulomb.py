@@ -59,12 +59,10 @@ RESOLVED_CORRECTIONS = 3  # ... at most, for the resolved stroke, where the line
 #                           position) is further from each position's real wear: each pass cuts the step's bias
 #                           about 5× (McColl 185 N 2D at 1 000 cycles, BDF2 against the run cycle by cycle: +1.9 %,
 #                           +0.26 %, +0.025 % after 0, 1, 3 from no correction; scripts/results/resolved_stepping.txt)
-CORRECTION_SHARE = 0.01  # ... but a resolved step starts from the last step's corrections and stops correcting once a
-#                         pass would move the deepest element's wear by less than this share of model.accuracy of
-#                         its depth: 1.4 passes a step instead of 4 (2.5 in 3D), and depth, width and the moving body's
-#                         depth within 0.02 %, 0.32 %, 0.00 % of the explicit run (the three corrections from scratch:
-#                         +0.02 %, +0.31 %, +0.01 %; McColl 185 N 2D, 18 000 cycles: scripts/results/bench_resolved.txt,
-#                         2026-11-26 third round)
+CORRECTION_SHARE = 0.01  # ... but a resolved step stops correcting once a pass would move the deepest element's wear
+#                         by less than this share of model.accuracy of its depth (McColl 185 N 2D, 18 000 cycles:
+#                         depth and width +0.03 % and +0.37 % of the run cycle by cycle, 4 at a time, peak pressure
+#                         −2 %: scripts/results/bench_resolved.txt, fifth round)
 STOPPED_BIAS = 4  # ... and a step stopped so counts this many times that share in its error estimate: the pass's
 #                  defect (the mid-stroke increment's, at the deepest element) understates what stopping leaves, which
 #                  summed to 0.13 % at 1 000 cycles against the run cycle by cycle where the defects said 0.03 % and
@@ -402,16 +400,19 @@ def _response(compliance, step: float, w_lin, mismatch: np.ndarray) -> np.ndarra
 
 def _resolved_step(member: CoulombCycle, wear_moving, wear_stationary, normal, guess, step: float, memory,
                    cycle: int, detail: bool) -> Cycle:
-    """A resolved implicit step: its increments' gaps corrected for the wear the cycle really found, starting
-    from the last step's corrections scaled to this step (the mismatch grows with the step and changes slowly
-    with the worn surface), and corrected again only while a pass would still move the deepest element's wear
-    by more than CORRECTION_SHARE of model.accuracy of its depth (at most RESOLVED_CORRECTIONS times).  Stopped
-    early, the step's ``bias`` (its estimate's share) is STOPPED_BIAS times that bound."""
-    memory = memory or {}
-    correction = _reused(memory, step, 2 * member.increments + 1)
+    """A resolved implicit step: its increments' gaps corrected for the wear the cycle really found, from no
+    correction, and corrected again only while a pass would still move the deepest element's wear by more than
+    CORRECTION_SHARE of model.accuracy of its depth (at most RESOLVED_CORRECTIONS times).  Stopped early, the
+    step's ``bias`` (its estimate's share) is STOPPED_BIAS times that bound.
+
+    Not from the last step's corrections scaled to this one (tried: 1.4 passes a step instead of 2): a correction
+    is sharp where the contact's edge was, and the edge moves between steps, so a reused one put spikes into the
+    gap that the wear then kept — McColl 185 N 2D peaked at 175–215 MPa from cycle 4 000 on where the run cycle by
+    cycle (4 at a time) has 72 MPa, 1.4 GPa on a grid four times finer, its width 0.3 % narrow
+    (scripts/results/bench_resolved.txt, fifth round)."""
     depth = float(np.max(wear_moving + wear_stationary))
     limit = CORRECTION_SHARE * member.accuracy * depth
-    cyc = None
+    cyc, correction = None, None
     for k in range(1 + RESOLVED_CORRECTIONS):
         cyc = member._solve(wear_moving, wear_stationary, normal, guess if cyc is None else cyc.pressure, step,
                             memory, cycle, detail, correction=correction, corrected=True)
@@ -423,17 +424,7 @@ def _resolved_step(member: CoulombCycle, wear_moving, wear_stationary, normal, g
         u, q = turning_loop(member.stroke, max(LOOP_SIDE_INCREMENTS, member.increments), member._tangential,
                             member._elastic_side, *cyc.turns, member.grid.area * member.volume_factor)
         cyc.loop, cyc.force_amplitude = (np.array(u), np.array(q)), float(np.abs(q).max())
-    cyc.memory.update(mismatches=np.stack(cyc.mismatch), mismatch_step=step)
     return cyc
-
-
-def _reused(memory: dict, step: float, count: int):
-    """The last implicit step's per-increment mismatches scaled to ``step`` (None: none kept, or for another
-    path)."""
-    last, last_step = memory.get("mismatches"), memory.get("mismatch_step")
-    if last is None or last_step is None or len(last) != count or not float(last_step) > 0:
-        return None
-    return list(np.asarray(last) * (step / float(last_step)))
 
 
 def _mismatches(visits: list, tally: _Tally, step: float, w_lin, dx: float, kernel: str) -> list:
