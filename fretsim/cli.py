@@ -476,15 +476,16 @@ def _body_fatigue(s: dict, body: str, f, both: bool) -> str:
     n = v("cycles_to_crack_initiation")
     err = s.get("estimated_error_cycles_to_crack", float("nan")) if body == "stationary" else float("nan")
     crit = f.critical_distance
-    where = (f"the largest point SWT {v('swt_max_MPa'):.3g} MPa at x = {v('swt_location_x_mm') * 1e3:.4g} µm, "
-             f"{v('swt_depth_um'):.3g} µm deep" + (f"; the damage counts its mean over the {crit * 1e3:.3g} µm below "
-                                                   f"each surface point" if crit else ""))
+    across = lambda key: (f", y = {v(key) * 1e3:.4g} µm" if math.isfinite(v(key)) else "")  # noqa: E731  (3D)
+    where = (f"the largest point SWT {v('swt_max_MPa'):.3g} MPa at x = {v('swt_location_x_mm') * 1e3:.4g} µm"
+             f"{across('swt_location_y_mm')}, {v('swt_depth_um'):.3g} µm deep"
+             + (f"; the damage counts its mean over the {crit * 1e3:.3g} µm below each surface point" if crit else ""))
     head = "Fretting fatigue" + (f" of the {'flat' if body == 'stationary' else 'moving body'}" if both or
                                  body == "moving" else "")
     if math.isfinite(n):
         return (f"{head}: a crack starts at cycle {n:,.0f}" + (f" (± {err:.1e} relative)" if math.isfinite(err)
                                                                else "")
-                + f" at x = {v('crack_location_x_mm') * 1e3:.4g} µm ({where})")
+                + f" at x = {v('crack_location_x_mm') * 1e3:.4g} µm{across('crack_location_y_mm')} ({where})")
     return (f"{head}: no crack within the run (Miner's sum reached {v('fatigue_damage'):.3g} of 1; {where})")
 
 

@@ -165,6 +165,16 @@ def test_a_3d_run_cracks_stops_there_and_says_where_across_the_stroke(cracked_3d
     assert abs(s["swt_location_y_mm"]) < a and s["swt_max_MPa"] > 0
 
 
+def test_the_paragraph_after_a_3d_run_says_where_across_the_stroke_the_crack_and_the_peak_are(cracked_3d):
+    """The run's sentence gives the crack's and the peak's y as the summary has them (a 3D crack's x alone does
+    not place it on the scar; a 2D run has no y, and its sentence is as before)."""
+    from fretsim.cli import _said
+    outcome, _ = cracked_3d
+    s, text = outcome.summary, _said(outcome)
+    assert f"at x = {s['crack_location_x_mm'] * 1e3:.4g} µm, y = {s['crack_location_y_mm'] * 1e3:.4g} µm (" in text
+    assert f"at x = {s['swt_location_x_mm'] * 1e3:.4g} µm, y = {s['swt_location_y_mm'] * 1e3:.4g} µm, " in text
+
+
 def test_a_3d_file_holds_the_fields_over_cycle_depth_y_x_and_exports_and_draws_them(cracked_3d, tmp_path):
     outcome, path = cracked_3d
     res = read_results(path)
