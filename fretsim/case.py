@@ -185,7 +185,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
                                   "radius): the strain-life curve's constants, a mapping of "
                                   + ", ".join(FATIGUE_KEYS_TEXT) + "; with it the run reports the body's SWT "
                                   "parameter under the contact, its crack-initiation life over the wear history "
-                                  "and the damage mode (2D; README); omitted: none", None)},
+                                  "and the damage mode (the flat's in 2D and 3D, the moving body's in 2D; README); "
+                                  "omitted: none", None)},
     "loading": {
         "normal_load": Key("force", "normal load P (total, both in 2D and 3D)", REQUIRED,
                            plausible=(1e-6, 1e7, "1 µN to 10 MN"), example="185 N"),

@@ -211,6 +211,14 @@ def test_the_moving_bodys_fatigue_in_3d_is_refused_with_its_key_and_the_flats_is
     assert load_case(BALL, [TI_FLAT]).stationary.fatigue is not None
 
 
+def test_the_case_reference_says_which_bodys_fatigue_runs_in_3d():
+    """The key's text said "(2D; README)" after the flat's fatigue in 3D had been lifted."""
+    from fretsim.templates import case_reference_markdown
+    line = next(row for row in case_reference_markdown().splitlines()
+                if row.startswith("| `materials.{moving,stationary}.fatigue` |"))
+    assert "(2D; README)" not in line and "the flat's in 2D and 3D, the moving body's in 2D" in line
+
+
 @pytest.mark.slow
 def test_a_3d_fatigue_run_whose_grid_is_widened_matches_one_on_the_wide_grid_from_the_start(underestimated, monkeypatch):
     """The seat on a rail with the flat's constants on an automatic grid sized for a thirtieth of its wear: widened
