@@ -963,7 +963,7 @@ def _fatigue(res: Results, body: str = "stationary"):
     sub = res.fatigue(body)
     summary = {k: res.summary.get(keyed(k, body), np.nan) for k in (
         "cycles_to_crack_initiation", "crack_location_x_mm", "swt_location_x_mm", "swt_depth_um", "swt_max_MPa",
-        "fatigue_damage")}
+        "fatigue_damage", "crack_location_y_mm", "swt_location_y_mm")}
     summary["damage_mode"] = res.summary.get("damage_mode", "–")
     swt, angle, z = sub["swt"], sub["swt_plane_angle"], sub["z"] * 1e3  # depths in µm
     peaks = np.array([np.nanmax(f) if np.isfinite(f).any() else np.nan for f in swt])
@@ -1003,12 +1003,15 @@ def _swt_overview(ax, fig, field, x, z, top: float, summary: dict) -> None:
     zs = slice(0, min(z.size, rows[-1] + 2))
     pc = ax.pcolormesh(x[xs], z[zs], field[zs, xs], shading="nearest", cmap="magma_r", vmin=0.0, vmax=top)
     fig.colorbar(pc, ax=ax, label="SWT (MPa)")
+    # (3D: the section is through one row; the peak's and the crack's own y said, as they may lie on another)
+    across = lambda key: (f" at y = {summary[key] * 1e3:.0f} µm" if np.isfinite(summary.get(key, np.nan))  # noqa
+                          else "")
     ax.plot(summary.get("swt_location_x_mm", np.nan) * 1e3, summary.get("swt_depth_um", np.nan), "c*", ms=12,
-            label=f"peak over the run: {summary.get('swt_max_MPa', np.nan):.3g} MPa")
+            label=f"peak over the run: {summary.get('swt_max_MPa', np.nan):.3g} MPa{across('swt_location_y_mm')}")
     crack = summary.get("cycles_to_crack_initiation", np.nan)
     if np.isfinite(crack):
         ax.plot(summary["crack_location_x_mm"] * 1e3, z[0], "bv", ms=9,
-                label=f"crack starts: cycle {crack:,.0f}".replace(",", " "))
+                label=f"crack starts: cycle {crack:,.0f}".replace(",", " ") + across("crack_location_y_mm"))
     ax.set_ylim(z[zs][-1], 0.0)
     ax.set_xlabel("x, sliding direction (µm)")
     ax.set_ylabel("depth below the surface (µm)")

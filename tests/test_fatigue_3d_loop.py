@@ -191,6 +191,9 @@ def test_a_3d_file_holds_the_fields_over_cycle_depth_y_x_and_exports_and_draws_t
     header = paths["subsurface.csv"].read_text().splitlines()[0]
     assert header.startswith("cycle,z [mm],x [mm],y [mm],swt [MPa]")
     assert "fatigue" in figures(res)
+    legend = [t.get_text() for t in figures(res, names=("fatigue",))["fatigue"].axes[0].get_legend().get_texts()]
+    y_um = lambda key: f" at y = {res.summary[key] * 1e3:.0f} µm"  # noqa: E731  (the section is one row of them)
+    assert legend[0].endswith(y_um("swt_location_y_mm")) and legend[1].endswith(y_um("crack_location_y_mm")), legend
 
 
 def test_a_3d_run_interrupted_with_fatigue_resumes_to_the_same_damage_and_crack(tmp_path):
