@@ -59,10 +59,11 @@ RESOLVED_CORRECTIONS = 3  # ... at most, for the resolved stroke, where the line
 #                           position) is further from each position's real wear: each pass cuts the step's bias
 #                           about 5× (McColl 185 N 2D at 1 000 cycles, BDF2 against the run cycle by cycle: +1.9 %,
 #                           +0.26 %, +0.025 % after 0, 1, 3 from no correction; scripts/results/resolved_stepping.txt)
-CORRECTION_SHARE = 0.01  # ... but a resolved step stops correcting once a pass would move the deepest element's wear
-#                         by less than this share of model.accuracy of its depth (McColl 185 N 2D, 18 000 cycles:
-#                         depth and width +0.03 % and +0.37 % of the run cycle by cycle, 4 at a time, peak pressure
-#                         −2 %: scripts/results/bench_resolved.txt, fifth round)
+CORRECTION_SHARE = 0.0  # ... a resolved step could stop correcting once a pass would move the deepest element's wear
+#                        by less than this share of model.accuracy of its depth; 0: every step corrects
+#                        RESOLVED_CORRECTIONS times.  At 0.01, with each step's corrections from none (not reused:
+#                        see _resolved_step), BDF2 at 1 000 cycles was +0.25 % off the run cycle by cycle against an
+#                        estimate of 0.17 %; with all three, +0.025 % against 0.031 % (tests/test_friction.py, slow)
 STOPPED_BIAS = 4  # ... and a step stopped so counts this many times that share in its error estimate: the pass's
 #                  defect (the mid-stroke increment's, at the deepest element) understates what stopping leaves, which
 #                  summed to 0.13 % at 1 000 cycles against the run cycle by cycle where the defects said 0.03 % and
