@@ -72,8 +72,8 @@ STOPPED_BIAS = 4  # ... and a step stopped so counts this many times that share 
 BIAS_FLOOR = 1e-4  # ... of the depth at least, whatever model.accuracy: what stopping leaves does not shrink with the
 #                  bound below it (model.accuracy 0.25 %: +0.135 % at 1 000 cycles, as at 1 %, estimated 0.18 % with
 #                  the floor, 0.07 % without; reused corrections corrected three times every step: +0.04 %)
-RESOLVED_PASSES = 2  # the cost estimate's passes per resolved implicit step: McColl 185 N took 1.4 in 2D (119 passes
-#                      for 86 steps tried), 2.5 in 3D (209 for 82 accepted)
+RESOLVED_PASSES = 1 + RESOLVED_CORRECTIONS  # the cost estimate's passes per resolved implicit step: every one
+#                                            corrects RESOLVED_CORRECTIONS times (CORRECTION_SHARE 0)
 FATIGUE_SIDE_INCREMENTS = 1  # each elastic side of a fatigue state's cycle (not recorded): the flat's stresses
 #                              over the side move between its ends (the damage with 1, 2 and 12 alike to 1e-11 at
 #                              4, 10 and 25 µm on cases/ti_fretting_fatigue.yaml)
@@ -406,7 +406,7 @@ def _resolved_step(member: CoulombCycle, wear_moving, wear_stationary, normal, g
     CORRECTION_SHARE of model.accuracy of its depth (at most RESOLVED_CORRECTIONS times).  Stopped early, the
     step's ``bias`` (its estimate's share) is STOPPED_BIAS times that bound.
 
-    Not from the last step's corrections scaled to this one (tried: 1.4 passes a step instead of 2): a correction
+    Not from the last step's corrections scaled to this one (tried: 1.4 passes a step instead of 4): a correction
     is sharp where the contact's edge was, and the edge moves between steps, so a reused one put spikes into the
     gap that the wear then kept — McColl 185 N 2D peaked at 175–215 MPa from cycle 4 000 on where the run cycle by
     cycle (4 at a time) has 72 MPa, 1.4 GPa on a grid four times finer, its width 0.3 % narrow
