@@ -55,25 +55,14 @@ CORRECTIONS = 1  # fixed-point corrections of an implicit step's gap for the wea
 SPREAD_TO_CORRECT = 0.1  # ... where the slip varies by more than this share of its largest (1 − mean/max): in gross
 #                         slip far above δ_t every point slides nearly alike, the linearisation is nearly exact
 #                         (McColl 185 N: 1e-5 without the correction) and the correction would cost 1.5× the time
-RESOLVED_CORRECTIONS = 3  # ... at most, for the resolved stroke, where the linear operator (a bound, the same at every
+RESOLVED_CORRECTIONS = 3  # ... every step of the resolved stroke, where the linear operator (a bound, the same at every
 #                           position) is further from each position's real wear: each pass cuts the step's bias
 #                           about 5× (McColl 185 N 2D at 1 000 cycles, BDF2 against the run cycle by cycle: +1.9 %,
 #                           +0.26 %, +0.025 % after 0, 1, 3 from no correction; scripts/results/resolved_stepping.txt)
-CORRECTION_SHARE = 0.0  # ... a resolved step could stop correcting once a pass would move the deepest element's wear
-#                        by less than this share of model.accuracy of its depth; 0: every step corrects
-#                        RESOLVED_CORRECTIONS times.  At 0.01, with each step's corrections from none (not reused:
-#                        see _resolved_step), BDF2 at 1 000 cycles was +0.25 % off the run cycle by cycle against an
-#                        estimate of 0.17 %; with all three, +0.025 % against 0.031 % (tests/test_friction.py, slow)
-STOPPED_BIAS = 4  # ... and a step stopped so counts this many times that share in its error estimate: the pass's
-#                  defect (the mid-stroke increment's, at the deepest element) understates what stopping leaves, which
-#                  summed to 0.13 % at 1 000 cycles against the run cycle by cycle where the defects said 0.03 % and
-#                  the shares 0.04 %; with 4× the estimate holds at jumping.tolerance 0.003, 0.01 and 0.03 (McColl
-#                  185 N 2D, 427 elements: scripts/results/bench_resolved.txt, 2026-11-26 third round)
-BIAS_FLOOR = 1e-4  # ... of the depth at least, whatever model.accuracy: what stopping leaves does not shrink with the
-#                  bound below it (model.accuracy 0.25 %: +0.135 % at 1 000 cycles, as at 1 %, estimated 0.18 % with
-#                  the floor, 0.07 % without; reused corrections corrected three times every step: +0.04 %)
-RESOLVED_PASSES = 1 + RESOLVED_CORRECTIONS  # the cost estimate's passes per resolved implicit step: every one
-#                                            corrects RESOLVED_CORRECTIONS times (CORRECTION_SHARE 0)
+# (a resolved step that stopped correcting once a pass moved the deepest wear by less than 1 % of model.accuracy of
+# its depth, with each step's corrections from none, was +0.25 % off the run cycle by cycle at 1 000 cycles against an
+# estimate of 0.17 %: every step corrects RESOLVED_CORRECTIONS times, +0.025 % against 0.031 %; tests/test_friction.py)
+RESOLVED_PASSES = 1 + RESOLVED_CORRECTIONS  # the cost estimate's passes per resolved implicit step
 FATIGUE_SIDE_INCREMENTS = 1  # each elastic side of a fatigue state's cycle (not recorded): the flat's stresses
 #                              over the side move between its ends (the damage with 1, 2 and 12 alike to 1e-11 at
 #                              4, 10 and 25 µm on cases/ti_fretting_fatigue.yaml)
@@ -98,7 +87,6 @@ class CoulombCycle:
     gap_model: str = "mid_stroke"  # at mid-stroke: how the flat's wear enters the mid-stroke gap
     increments: int = 9  # per half-stroke; odd, so that one is centred on mid-stroke
     volume_factor: float = 1.0  # the line length in 2D: grid volumes and forces → totals
-    accuracy: float = 0.01  # model.accuracy (a resolved implicit step corrects its gap down to a share of it)
     tolerance: float = 1e-10  # the tangential solver's
     name: str = "coulomb"
     linear: bool = False
@@ -114,8 +102,7 @@ class CoulombCycle:
         return cls(grid=spec.grid, compliance=spec.compliance, tangential=spec.tangential, stroke=block.stroke,
                    load=spec.load, total_load=block.normal_load, friction_coefficient=block.friction_coefficient,
                    k_moving=k_m, k_stationary=k_s, law=spec.law, rigid=rigid, resolved=spec.resolved,
-                   gap_model=spec.gap_model, increments=spec.increments, volume_factor=spec.volume_factor,
-                   accuracy=spec.accuracy)
+                   gap_model=spec.gap_model, increments=spec.increments, volume_factor=spec.volume_factor)
 
     @property
     def kernel(self) -> str:
@@ -401,25 +388,18 @@ def _response(compliance, step: float, w_lin, mismatch: np.ndarray) -> np.ndarra
 
 def _resolved_step(member: CoulombCycle, wear_moving, wear_stationary, normal, guess, step: float, memory,
                    cycle: int, detail: bool) -> Cycle:
-    """A resolved implicit step: its increments' gaps corrected for the wear the cycle really found, from no
-    correction, and corrected again only while a pass would still move the deepest element's wear by more than
-    CORRECTION_SHARE of model.accuracy of its depth (at most RESOLVED_CORRECTIONS times).  Stopped early, the
-    step's ``bias`` (its estimate's share) is STOPPED_BIAS times that bound.
+    """A resolved implicit step: its increments' gaps corrected RESOLVED_CORRECTIONS times for the wear the cycle
+    really found, from no correction.
 
     Not from the last step's corrections scaled to this one (tried: 1.4 passes a step instead of 4): a correction
     is sharp where the contact's edge was, and the edge moves between steps, so a reused one put spikes into the
-    gap that the wear then kept — McColl 185 N 2D peaked at 175–215 MPa from cycle 4 000 on where the run cycle by
-    cycle (4 at a time) has 72 MPa, 1.4 GPa on a grid four times finer, its width 0.3 % narrow
-    (scripts/results/bench_resolved.txt, fifth round)."""
-    depth = float(np.max(wear_moving + wear_stationary))
-    limit = CORRECTION_SHARE * member.accuracy * depth
+    gap that the wear then kept — McColl 185 N 2D peaked at 328 MPa at 6 000 cycles where the run cycle by cycle
+    has 81 MPa, 1.4 GPa on a grid four times finer, its width 0.3 % narrow (scripts/results/bench_resolved.txt,
+    fifth round)."""
     cyc, correction = None, None
-    for k in range(1 + RESOLVED_CORRECTIONS):
+    for _ in range(1 + RESOLVED_CORRECTIONS):
         cyc = member._solve(wear_moving, wear_stationary, normal, guess if cyc is None else cyc.pressure, step,
                             memory, cycle, detail, correction=correction, corrected=True)
-        if cyc.defect <= limit:
-            cyc.bias = STOPPED_BIAS * max(limit, BIAS_FLOOR * depth)
-            break
         correction = cyc.mismatch
     if detail is True and not member.rigid:  # the recorded loop, of the pass returned only (48 ms a 2D draw)
         u, q = turning_loop(member.stroke, max(LOOP_SIDE_INCREMENTS, member.increments), member._tangential,

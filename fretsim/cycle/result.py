@@ -68,7 +68,6 @@ class CycleSpec:
     resolved: bool  # the normal contact solved at each increment of the stroke (model.stroke resolved)
     increments: int  # per half-stroke
     volume_factor: float  # the line length in 2D: grid volumes and forces → totals
-    accuracy: float = 0.01  # model.accuracy: what an implicit step's corrections need not resolve below
 
 
 def stick_half_width(stick_row: np.ndarray, x: np.ndarray, dx: float) -> float:

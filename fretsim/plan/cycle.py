@@ -219,7 +219,7 @@ def build(case: Case, plan: Plan, grids, model, regime_: Regime, proxy_case: Cas
             grid=grid, solve_grid=model.solve_compliance.grid, compliance=model.compliance,
             tangential=regime_.tangential, block=block, load=grid_load(case, grid, block.normal_load),
             law=case.law, moving=case.moving, stationary=case.stationary, gap_model=model.gap_model,
-            increments=case.increments, accuracy=case.accuracy,
+            increments=case.increments,
             volume_factor=case.geometry.line_length if grid.plane_strain else 1.0))
 
     members = tuple(built.setdefault(b, member(b)) for b in case.loading.blocks)
