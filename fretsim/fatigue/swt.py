@@ -377,13 +377,18 @@ def swt_3d(history, youngs: float, poisson: float, normals: Optional[np.ndarray]
     return CriticalPlane3D(best.reshape(shape), normal.reshape(shape + (3,)))
 
 
+def _plane_weights(normals) -> tuple:
+    """The unit normals (k, 3) and their weights (6, k): σ_n = nᵀσn as one product of the six components against
+    (nx², ny², nz², 2nxny, 2nxnz, 2nynz)."""
+    n = np.asarray(normals, dtype=float)
+    n = n / np.linalg.norm(n, axis=1, keepdims=True)
+    return n, np.stack([n[:, 0] ** 2, n[:, 1] ** 2, n[:, 2] ** 2, 2 * n[:, 0] * n[:, 1], 2 * n[:, 0] * n[:, 2],
+                        2 * n[:, 1] * n[:, 2]])
+
+
 def _best_over(flat: np.ndarray, normals: Optional[np.ndarray], youngs: float, poisson: float, chunk: int) -> tuple:
     """Each point's best plane among ``normals`` from the history (6, time, points): (SWT, normal (points, 3))."""
-    n = hemisphere_normals() if normals is None else np.asarray(normals, dtype=float)
-    n = n / np.linalg.norm(n, axis=1, keepdims=True)
-    # σ_n = nᵀσn as one product: the six components against (nx², ny², nz², 2nxny, 2nxnz, 2nynz)
-    weights = np.stack([n[:, 0] ** 2, n[:, 1] ** 2, n[:, 2] ** 2, 2 * n[:, 0] * n[:, 1], 2 * n[:, 0] * n[:, 2],
-                        2 * n[:, 1] * n[:, 2]])
+    n, weights = _plane_weights(hemisphere_normals() if normals is None else normals)
     points = flat.shape[2]
     best = np.empty(points)
     where = np.empty(points, dtype=int)
@@ -428,15 +433,8 @@ def bound_3d(history, youngs: float, poisson: float) -> np.ndarray:
     principal values bounded by Gershgorin's discs (a few array operations, not an eigen-solve per point and
     state).  ``history`` (6, time, ...)."""
     s = history if isinstance(history, np.ndarray) and history.shape[0] == 6 else _components(history)
-    sxx, syy, szz = s[0], s[1], s[2]
-    axy, axz, ayz = np.abs(s[3]), np.abs(s[4]), np.abs(s[5])
-    rx, ry, rz = axy + axz, axy + ayz, axz + ayz  # the discs' radii
-    upper = np.maximum(np.maximum(sxx + rx, syy + ry), szz + rz)
-    lower = np.minimum(np.minimum(sxx - rx, syy - ry), szz - rz)
-    trace = sxx + syy + szz
-    e_hi = ((1.0 + poisson) * upper - poisson * trace).max(axis=0) / youngs
-    e_lo = ((1.0 + poisson) * lower - poisson * trace).min(axis=0) / youngs
-    return np.maximum(upper.max(axis=0), 0.0) * 0.5 * (e_hi - e_lo)
+    shape = s.shape[2:]
+    return _slid_bound(s.reshape(6, s.shape[1], 1, -1), {}, youngs, poisson).reshape(shape)
 
 
 def swt_search_3d(history, youngs: float, poisson: float, skip: float = 0.0, full: bool = True,
@@ -523,9 +521,7 @@ def _coarse_rows(rows: np.ndarray, slides: dict, search: np.ndarray, normals: np
                  poisson: float) -> tuple:
     """The first pass over the rows holding searched points, a few rows at a time: each plane's normal stress and
     strain per state, a slid state's over its window (:func:`_window`), their extremes over the history."""
-    n = normals / np.linalg.norm(normals, axis=1, keepdims=True)
-    weights = np.stack([n[:, 0] ** 2, n[:, 1] ** 2, n[:, 2] ** 2, 2 * n[:, 0] * n[:, 1], 2 * n[:, 0] * n[:, 2],
-                        2 * n[:, 1] * n[:, 2]])
+    n, weights = _plane_weights(normals)
     nx = rows.shape[-1]
     wanted = np.unique(search // nx)
     group = max(1, CHUNK // (nx * len(n)))
