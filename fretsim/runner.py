@@ -5,6 +5,7 @@ The public face of this module is :mod:`fretsim.api`; sweeps (:mod:`fretsim.swee
 from __future__ import annotations
 
 import dataclasses
+import functools
 import math
 import signal
 import threading
@@ -194,6 +195,14 @@ def resume(output: str | Path, *, progress: Optional[Callable[[int], None]] = No
             raise CaseError(str(output), [("", f"/checkpoint: the cycle {str(n)[:20]} does not fit the case's "
                                                f"{setup.cycles} cycles")], "results file")
         sink = _Sink(output, setup, filled, plan, True, previous)
+        if previous.coarsenings:  # on the grid the run had coarsened to, from its checkpoint's coarse elements
+            factor = sink.factor
+            run_setup, run_filled, _ = prepare(filled.with_choices(elements=(setup.grid.shape[1] // factor,)),
+                                               runs=runs)
+            sink.follow(dataclasses.replace(run_setup, per_cycle=setup.per_cycle), run_filled)  # (regrid.step_down)
+            previous = dataclasses.replace(previous, checkpoint={
+                k: regrid.restrict(v, setup.grid.shape, factor) for k, v in previous.checkpoint.items()})
+            setup = sink.setup
         return _execute(setup, filled, plan, sink, progress, observers, previous, runs)
     finally:
         if claim is not None:
@@ -210,6 +219,39 @@ class _Sink:
         self.overwrite, self.previous, self.input_sha256 = overwrite, previous, input_sha256
         self.writer: Optional[ResultsWriter] = None
         self.regrids: list = list(previous.regrids) if previous is not None else []  # the grid's widenings so far
+        self.coarsenings: list = list(previous.coarsenings) if previous is not None else []  # ... its coarsenings
+        # the output grid (the finest the run used: the results' /grid), and the run's own case on its grid
+        self.out_grid, self.run_filled = setup.grid, filled
+        self.rule = regrid.rule_for(filled, setup, plan)  # when the grid may coarsen (None: never)
+
+    @property
+    def factor(self) -> int:
+        """The run's element along x in output elements."""
+        return self.coarsenings[-1].factor if self.coarsenings else 1
+
+    def follow(self, setup, run_filled) -> None:
+        """The run goes on on ``setup``'s grid (coarser than the output grid; its own filled case ``run_filled``)."""
+        self.setup, self.run_filled = dataclasses.replace(setup, notes=tuple(self.setup.notes)), run_filled
+
+    def coarsen(self, made, pad_r, setup, run_filled, plan, state: dict, note: str, runs) -> None:
+        """The run moves onto a coarser grid (``made``), from ``state``; the output grid is first widened by the
+        padding ``pad_r`` (of the run's grid) where the merge needed it.  A Ctrl-C before the next step resumes on
+        the coarser grid."""
+        self.open(self.overwrite)
+        if pad_r is not None:
+            r_out = regrid.scaled(pad_r, self.factor)
+            out_setup, out_filled, _ = prepare(self.filled.with_choices(domain=r_out.new_domain[:1],
+                                                                         elements=r_out.new_elements[:1]), runs=runs)
+            self.regrids.append(r_out)
+            self.out_grid, self.filled, self.plan = out_setup.grid, out_filled, regrid.replanned(plan, r_out, True)
+            if self.writer is not None:
+                self.writer.regrid(r_out, self.out_grid, out_filled.to_yaml(), self.plan.choices, self.writer.notes)
+        self.coarsenings.append(made)
+        self.follow(setup, run_filled)
+        if self.writer is not None:
+            self.writer.coarsen(made)
+            self.writer.notes = tuple(dict.fromkeys(self.writer.notes + (note,)))
+            self.writer.state = state
 
     def regrid(self, r, setup, filled, plan, state: dict, note: str) -> None:
         """The run moves onto a widened grid, from ``state`` (the last step's, widened): so does what the results
@@ -218,6 +260,7 @@ class _Sink:
         self.open(self.overwrite)  # a resumed run may widen before its first step: the file's snapshots go too
         self.regrids.append(r)
         self.setup, self.filled, self.plan = setup, filled, plan
+        self.out_grid, self.run_filled = setup.grid, filled
         if self.writer is not None:
             self.writer.regrid(r, setup.grid, filled.to_yaml(), plan.choices,
                                tuple(dict.fromkeys(self.writer.notes + (note,))))
@@ -225,10 +268,11 @@ class _Sink:
 
     def open(self, overwrite: bool) -> None:
         if self.writer is None and self.output is not None:
-            self.writer = ResultsWriter(self.output, self.filled.to_yaml(), self.filled.name, self.setup.grid,
+            self.writer = ResultsWriter(self.output, self.filled.to_yaml(), self.filled.name, self.out_grid,
                                         self.setup.notes, overwrite, previous=self.previous,
                                         choices=self.plan.choices, inputs=inputs_of(self.filled),
-                                        input_sha256=self.input_sha256, regrids=self.regrids)
+                                        input_sha256=self.input_sha256, regrids=self.regrids,
+                                        coarsenings=self.coarsenings)
 
     def on_step(self, setup_, step) -> None:
         self.open(self.overwrite)
@@ -314,6 +358,29 @@ def _simulate(counter, sink: _Sink, observers, progress, state, runs: SideRuns) 
             state, why = _widen(exc, counter, sink, runs, state)
             if state is None:
                 return "failed", _unwidened(exc, sink.setup.grid, why)
+        except regrid.Coarsen as exc:
+            state = _coarsen(exc, counter, sink, runs)
+
+
+def _coarsen(exc: "regrid.Coarsen", counter, sink: _Sink, runs: SideRuns) -> dict:
+    """The state of the step that allowed it on the grid three times coarser, the run's setup and its results file
+    moved onto it (:mod:`fretsim.regrid`); the same state, no longer coarsening, where the planner refuses the
+    coarser grid."""
+    setup = sink.setup
+    try:
+        new_setup, run_filled, plan, state, pad_r, made = regrid.step_down(
+            setup, sink.run_filled, exc, functools.partial(prepare, runs=runs), sink.factor)
+    except CaseError as err:
+        sink.rule = None
+        counter.notes.append(f"the automatic grid was not coarsened at cycle {exc.step.cycle}: "
+                             f"{str(err).splitlines()[-1][:200]}")
+        return exc.step.state
+    if counter.last is not None:
+        counter.last = regrid.coarsened_record(counter.last, setup.grid, pad_r)
+    note = regrid.describe_coarsening(made, setup.grid.shape[1])
+    counter.notes.append(note)
+    sink.coarsen(made, pad_r, new_setup, run_filled, sink.plan, state, note, runs)
+    return state
 
 
 def _unwidened(exc: DomainError, grid, why: str) -> str:
@@ -344,20 +411,25 @@ def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns,
                f"beyond its estimate")
         counter.notes.append(why)
         return None, why
-    r = regrid.widened(setup.grid, exc.axis, setup.band, int(base["n"]),
-                       f"the contact reached the {exc.axis} edge at cycle {exc.cycle}")
+    run_r = regrid.widened(setup.grid, exc.axis, setup.band, int(base["n"]),
+                           f"the contact reached the {exc.axis} edge at cycle {exc.cycle}")
+    r = regrid.scaled(run_r, sink.factor)  # the output grid's widening (the same where the grid never coarsened)
     plane = setup.grid.plane_strain
     wider = filled.with_choices(domain=r.new_domain[:1] if plane else r.new_domain,
                                 elements=r.new_elements[:1] if plane else r.new_elements)
     try:
         new_setup, new_filled, _ = prepare(wider, runs=runs)
+        if sink.factor > 1:
+            run_setup, run_filled, _ = prepare(sink.run_filled.with_choices(domain=run_r.new_domain[:1],
+                                                                            elements=run_r.new_elements[:1]),
+                                               runs=runs)
     except CaseError as err:  # e.g. more memory than the machine has
         why = f"the automatic grid could not be widened: {str(err).splitlines()[-1][:200]}"
         counter.notes.append(why)
         return None, why
-    state = regrid.pad_state(base, r)
+    state = regrid.pad_state(base, run_r)
     if counter.last is not None:
-        counter.last = regrid.pad_record(counter.last, r)
+        counter.last = regrid.pad_record(counter.last, run_r)
     note = regrid.describe(r)
     if setup.coarse is not None and new_setup.coarse is not None:  # refinement: not nested, so not exact
         note += (f"; the coarse grid of refinement is re-derived on the wider domain, its element "
@@ -366,13 +438,15 @@ def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns,
     counter.notes.append(note)
     sink.regrid(r, dataclasses.replace(new_setup, notes=tuple(setup.notes)), new_filled,
                 regrid.replanned(plan, r, plane), state, note)
+    if sink.factor > 1:
+        sink.follow(dataclasses.replace(run_setup, per_cycle=setup.per_cycle), run_filled)  # (regrid.step_down)
     return state, ""
 
 
 def _simulate_on(setup, plan, counter, sink: _Sink, observers, progress, state) -> tuple[str, str]:
     """One stretch of the loop on one grid (a DomainError passes through to be widened)."""
     try:
-        last = simulate(setup, (counter, sink) + tuple(observers), progress, resume=state)
+        last = simulate(setup, (counter, sink) + tuple(observers), progress, resume=state, coarsen=sink.rule)
     except DomainError:
         raise
     except ResolutionError as exc:  # found before anything is written: an input problem, named as such
@@ -398,7 +472,7 @@ def _estimate_errors(setup, filled, plan, counter, sink: _Sink, t0, runs: SideRu
     file: the estimates are then unknown, and it says why."""
     started = time.perf_counter()
     try:
-        counter.extra = _error_estimates(setup, filled, plan, counter, runs)
+        counter.extra = _error_estimates(setup, filled, plan, counter, runs, tuple(sink.coarsenings))
     except KeyboardInterrupt:
         sink.finish_interrupted(counter, t0, lambda: "interrupted while estimating the grid's error (the run itself "
                                 f"is complete); resume with `fretsim run --resume {sink.output}`")
@@ -459,25 +533,30 @@ def _summary(setup, counter, t0) -> dict:
     return in_summary_order(out)
 
 
-def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter", runs: SideRuns) -> dict:
+def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter", runs: SideRuns,
+                     coarsenings: tuple = ()) -> dict:
     """The total error estimates of the reported numbers: the stepping's, the grid's (from a companion run on a
-    grid twice as coarse, see :mod:`fretsim.grid_error`) and the model difference ``auto`` accepted."""
+    grid twice as coarse, see :mod:`fretsim.grid_error`, which coarsens where the run did: ``coarsenings``) and
+    the model difference ``auto`` accepted."""
     summary = summarize(setup, counter.last, counter.solves, 0.0, counter.errors)
     model_part = sum(c.error for c in plan.choices)
     if not _estimated(filled):
         return {**grid_error.totals(summary, None, model_part), grid_error.LIMIT_KEY: float("nan")}
     companion, coarsest_case = _companions(setup, filled)
+    replay = tuple(c.cycle for c in coarsenings)
     try:
-        c_setup, _, _ = prepare(companion, runs=runs)
-        last = runs.run(f"grid error: the case again on a grid twice as coarse ({c_setup.grid.shape[1]} × "
-                        f"{c_setup.grid.shape[0]} elements) to estimate the grid's part of the error", c_setup)
+        c_setup, c_filled, _ = prepare(companion, runs=runs)
+        last, c_setup = _side_run(runs, f"grid error: the case again on a grid twice as coarse "
+                                        f"({c_setup.grid.shape[1]} × {c_setup.grid.shape[0]} elements"
+                                        f"{', coarsened where the run was' if replay else ''}) to estimate the grid's "
+                                        f"part of the error", c_setup, c_filled, replay)
     except (SimulationError, CaseError) as exc:  # e.g. the mid-stroke gap, stable on the run's grid, is not on
         #                                           the coarser one: the run stands, its grid error is unknown
         counter.notes.append(f"the grid's error was not estimated: its companion run on a grid twice as coarse "
                              f"stopped ({str(exc)[:160]})")
         return {**grid_error.totals(summary, None, model_part), grid_error.LIMIT_KEY: float("nan")}
     coarse = summarize(c_setup, last, 0, 0.0)
-    coarsest = _coarsest(coarsest_case, runs)
+    coarsest = _coarsest(coarsest_case, runs, replay)
     part = grid_error.grid_estimates(summary, coarse, counter.last.pressure, setup.grid, last.pressure,
                                      c_setup.grid, coarsest)
     out = grid_error.totals(summary, part, model_part)
@@ -533,17 +612,28 @@ def _companions(setup: Setup, filled: Case) -> tuple[Case, Case]:
     return tuple(grid_error.companion_case(filled, line_contact, times=times) for times in (1, 2))
 
 
-def _coarsest(case: Case, runs: SideRuns) -> Optional[dict]:
+def _coarsest(case: Case, runs: SideRuns, replay: tuple = ()) -> Optional[dict]:
     """The summary of the run on a grid four times as coarse (whether the peak pressure converges), or None where
     that grid cannot carry the run (too few elements for the contact, an unstable gap): the peak is then read
     from two grids."""
     try:
-        c_setup, _, _ = prepare(case, runs=runs)
-        return summarize(c_setup, runs.run(f"grid error: the case again on a grid four times as coarse "
-                                           f"({c_setup.grid.shape[1]} × {c_setup.grid.shape[0]} elements) to see "
-                                           f"whether the peak pressure converges", c_setup), 0, 0.0)
+        c_setup, c_filled, _ = prepare(case, runs=runs)
+        last, c_setup = _side_run(runs, f"grid error: the case again on a grid four times as coarse "
+                                        f"({c_setup.grid.shape[1]} × {c_setup.grid.shape[0]} elements) to see "
+                                        f"whether the peak pressure converges", c_setup, c_filled, replay)
+        return summarize(c_setup, last, 0, 0.0)
     except (SimulationError, CaseError):
         return None
+
+
+def _side_run(runs: SideRuns, what: str, setup: Setup, filled: Case, replay: tuple) -> tuple[Step, Setup]:
+    """A companion run and the setup it ended on: coarsened at the first step at or past each of the ``replay``
+    cycles, where the run coarsened (so that its estimate covers the grids the run used)."""
+    if not replay:
+        return runs.run(what, setup), setup
+    last, setup, _ = runs.run_following(what, setup, filled, regrid.Replay(replay),
+                                        functools.partial(prepare, runs=runs))
+    return last, setup
 
 
 def _elapsed(counter, t0) -> float:

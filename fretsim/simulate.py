@@ -33,6 +33,7 @@ from fretsim.loop import blocks, checkpoint, checks, fatigue
 from fretsim.loop.landing import Landing, Reached
 from fretsim.quantities import wear_summary
 from fretsim.refine import coarsen, refine_pressure
+from fretsim.regrid import Coarsen
 from fretsim.solvers import solve
 from fretsim.stability import GrowthWatch, checkerboard_signed
 from fretsim.stepping import SCHEMES, relative_change
@@ -134,13 +135,17 @@ class Observer(Protocol):
 
 
 def simulate(setup: Setup, observers: tuple = (), progress: Optional[Callable[[int], None]] = None,
-             resume: Optional[dict] = None) -> Step:
+             resume: Optional[dict] = None, coarsen: Optional[Callable] = None) -> Step:
     """Run the loop to ``setup.cycles``; returns the last step.  Raises :class:`SimulationError` on failure.
 
     ``resume`` is a checkpoint (``Step.state`` of an earlier run of the same setup): the loop continues from
-    it and produces the same steps as the uninterrupted run.
+    it and produces the same steps as the uninterrupted run.  ``coarsen(setup, step)``, given, is asked after
+    each accepted step whether the grid may coarsen (a reason, or None); where it may, :class:`fretsim.regrid.
+    Coarsen` is raised with the step, which the observers have already had (:mod:`fretsim.regrid`).
     """
-    return _Loop(setup, observers, progress).run(resume)
+    loop = _Loop(setup, observers, progress)
+    loop.coarsen = coarsen
+    return loop.run(resume)
 
 
 class _Loop:
@@ -189,6 +194,7 @@ class _Loop:
         self.watch = GrowthWatch()
         self._summed = (None, None, None)  # (extra, compliance, their sum) of the last implicit solve
         self.miners = fatigue.miners(setup)  # each body's fatigue damage so far (loop.fatigue)
+        self.coarsen: Optional[Callable] = None  # asked after each step whether the grid may coarsen (regrid)
 
     def restore(self, st: dict) -> None:
         checkpoint.restore(self, st)
@@ -278,6 +284,10 @@ class _Loop:
         if verdict == "reached":
             raise Reached(step)
         checks.check_body(s.limits, s.grid, self.h_m, self.p, self.n)
+        if self.coarsen is not None and 0 < self.n < s.cycles:
+            why = self.coarsen(s, step)
+            if why:
+                raise Coarsen(step, why)
         return step
 
     def _fatigue_due(self, cycle: int) -> bool:

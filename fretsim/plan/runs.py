@@ -39,6 +39,17 @@ class SideRuns:
         with self.progress(setup) as update:
             return simulate(setup, progress=update)
 
+    def run_following(self, what: str, setup, case, rule, prepare_fn):
+        """:meth:`run` carried through the grid's coarsenings (:func:`fretsim.regrid.following`): (last step, the
+        setup it ended on, the coarsenings)."""
+        from fretsim.regrid import following
+        self.say(what)
+        if self.progress is None:
+            return following(lambda s, st, r: simulate(s, resume=st, coarsen=r), setup, case, rule, prepare_fn)
+        with self.progress(setup) as update:
+            return following(lambda s, st, r: simulate(s, progress=update, resume=st, coarsen=r), setup, case,
+                             rule, prepare_fn)
+
     def remembered(self, cache: dict, key: str, compute: Callable[[], Any]) -> Any:
         """``cache[key]``, computed once."""
         value = cache.get(key, _MISSING)  # one lookup: another thread may clear the cache between two

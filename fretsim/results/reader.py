@@ -43,6 +43,7 @@ class Results:
     inputs: dict = field(default_factory=dict)  # name: (value, units)
     overrides: list = field(default_factory=list)
     regrids: list = field(default_factory=list)  # the automatic grid's widenings (fretsim.regrid.Regrid), in order
+    coarsenings: list = field(default_factory=list)  # ... and its coarsenings (fretsim.regrid.Coarsening)
     subsurface: dict = field(default_factory=dict)  # fretting fatigue: z (mm) and fields (cycle, z, [y,] x) below
     #                                                  the flat (swt, …) and the moving body (swt_moving, …): see fatigue()
 
@@ -292,10 +293,12 @@ def _read(f, path: str, for_resume: bool, seals: bool = True) -> Results:
         provenance = [(*c, g, e) for c, g, e in zip(choices, given, error)]
     inputs, overrides = _read_inputs(f)
     regrids = _read_regrids(f, (nx, ny)) if "regrids" in f else []
+    coarsenings = _read_coarsenings(f, nx) if "coarsenings" in f else []
     return Results(path=path, attrs=attrs, case_yaml=case_yaml, x=x, y=y, history=history, fields=fields,
                    summary=summary, units=units, checkpoint=checkpoint, fretting_loop=loop, choices=choices,
                    provenance=provenance,
-                   inputs=inputs, overrides=overrides, regrids=regrids, subsurface=subsurface)
+                   inputs=inputs, overrides=overrides, regrids=regrids, subsurface=subsurface,
+                   coarsenings=coarsenings)
 
 
 # what each format added that a file of an older one cannot hold: (test, its description)
@@ -438,6 +441,23 @@ def _read_inputs(f) -> tuple[dict, list]:
         except (ValueError, TypeError):
             raise _Damaged("/inputs: its overrides attribute is not a JSON list") from None
     return inputs, overrides
+
+
+def _read_coarsenings(f, nx: int) -> list:
+    """/coarsenings as :class:`fretsim.regrid.Coarsening` records: factors growing by 3, the last dividing the grid."""
+    from fretsim.regrid import COARSEN, Coarsening
+    _group(f, "coarsenings")
+    cycles = _dataset(f, "coarsenings/cycle", 1)
+    n = cycles.size
+    factors = _dataset(f, "coarsenings/factor", 1, shape=(n,))
+    elements = _dataset(f, "coarsenings/elements_x", 1, shape=(n,))
+    reasons = [text(v) for v in _dataset(f, "coarsenings/reason", 1, numeric=False, shape=(n,))]
+    out = [Coarsening(int(cycles[i]), int(factors[i]), (int(elements[i]), 1), reasons[i]) for i in range(n)]
+    if [c.factor for c in out] != [COARSEN ** (i + 1) for i in range(n)]:
+        raise _Damaged(f"/coarsenings: factors {[c.factor for c in out]}, expected powers of {COARSEN}")
+    if out and nx % out[-1].factor:  # (a widening after it adds whole run elements: the count may have grown)
+        raise _Damaged(f"/coarsenings: elements of {out[-1].factor} do not tile the grid's {nx}")
+    return out
 
 
 def _read_regrids(f, elements: tuple) -> list:

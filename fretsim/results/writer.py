@@ -41,7 +41,7 @@ class ResultsWriter:
 
     def __init__(self, path: str | Path, case_yaml: str, case_name: str, grid, notes=(), overwrite: bool = False,
                  previous: Optional["Results"] = None, choices=(), inputs: Optional[dict] = None,
-                 input_sha256: str = "", regrids=()):
+                 input_sha256: str = "", regrids=(), coarsenings=()):
         self.path = Path(path)
         self.replace = overwrite or previous is not None
         if self.path.exists() and not self.replace:
@@ -62,6 +62,8 @@ class ResultsWriter:
             self.rows, self.fields, self.field_cycles = [], {k: [] for k in FIELDS}, []
             self.loops = []  # (applied displacement um, tangential force N) at each snapshot
         self.regrids = list(regrids)  # the automatic grid's widenings (fretsim.regrid.Regrid)
+        # ... and its coarsenings (fretsim.regrid.Coarsening): the run's element is ``factor`` output elements
+        self.coarsenings = list(coarsenings)
         # fretting fatigue's fields below the flat at each snapshot, each (layers, y, x), and the layers' depths
         self.depths = previous.subsurface.get("z") if previous is not None else None
         self.subsurface = ({k: [a if a.ndim == 3 else a[:, None, :] for a in v]
@@ -78,7 +80,7 @@ class ResultsWriter:
         if step.is_snapshot and (not self.field_cycles or self.field_cycles[-1] != step.cycle):
             self.field_cycles.append(step.cycle)
             for name, (_, _, get) in FIELDS.items():
-                self.fields[name].append(np.array(get(step)))
+                self.fields[name].append(self._on_output(np.array(get(step))))
             if setup.fatigue_specs:
                 _add_subsurface(self, setup, step)
             loop = step.cycle_result.loop
@@ -93,6 +95,25 @@ class ResultsWriter:
         # a flush rebuilds the whole file (tens of ms): never let flushing take more than ~5 % of a long run
         if now - self._flushed > max(FLUSH_SECONDS, FLUSH_COST_FACTOR * self._flush_cost):
             self.flush()
+
+    @property
+    def factor(self) -> int:
+        """The run's element along x in output elements (1 until the grid coarsens)."""
+        return self.coarsenings[-1].factor if self.coarsenings else 1
+
+    def _on_output(self, value):
+        """An array (or a list of them, or a state) on the run's grid written on the output grid: each coarse value
+        repeated over its output elements (:mod:`fretsim.regrid`)."""
+        from fretsim.regrid import prolong
+        f = self.factor
+        shape = (self.grid.shape[0], self.grid.shape[1] // f)
+        if isinstance(value, dict):
+            return {k: prolong(v, shape, f) for k, v in value.items()}
+        return prolong(value, shape, f)
+
+    def coarsen(self, c) -> None:
+        """The run goes on on a grid coarsened by :mod:`fretsim.regrid` (``c``): its next states are prolonged."""
+        self.coarsenings.append(c)
 
     def regrid(self, r, grid, case_yaml: str, choices, notes) -> None:
         """The run moved onto a widened grid (:mod:`fretsim.regrid`): the snapshots so far are padded onto it (the
@@ -219,16 +240,19 @@ class ResultsWriter:
         w.attrs(s, **self.summary)
         if self.summary:
             w.attrs(s, units=", ".join(f"{k}: {SUMMARY_UNITS.get(k, '1')}" for k in self.summary))
+        if self.coarsenings:
+            _write_coarsenings(self, w, f)
         if self.state is not None:  # not sealed: it carries its own digest (but the root names it)
             c = w.unsealed_group(f, "checkpoint")
-            for key, value in self.state.items():
+            state = self._on_output(self.state)  # on the output grid: a resume takes each coarse element's middle
+            for key, value in state.items():
                 if isinstance(value, np.ndarray):
                     c.create_dataset(key, data=value)
                 elif isinstance(value, list):  # a list of arrays (the schemes' memory)
                     c.create_dataset(key, data=np.array(value)) if value else c.attrs.__setitem__(key + "_empty", 1)
                 elif value is not None:
                     c.attrs[key] = value
-            c.attrs["sha256"] = checkpoint_digest(self.state)
+            c.attrs["sha256"] = checkpoint_digest(state)
         w.seal()
 
     def _write_loops(self, w: "_SealingWriter", f: h5py.File) -> None:
@@ -305,6 +329,21 @@ def _write_regrids(writer: "ResultsWriter", w: "_SealingWriter", f: h5py.File) -
                                 f"{' (1 in 2D: the plane-strain row)' if axis == 'y' else ''}")
     w.dataset(g, "reason", [r.reason for r in rs], h5py.string_dtype())
 
+
+
+def _write_coarsenings(writer: "ResultsWriter", w: "_SealingWriter", f: h5py.File) -> None:
+    g = w.group(f, "coarsenings")
+    w.attrs(g, long_name="each coarsening of the automatic grid as the contact grew: from its cycle on, the run's "
+                         "element along x is `factor` elements of /grid, and the snapshots are written with each of "
+                         "its values repeated over them (piecewise constant, the same worn volume)")
+    cs = writer.coarsenings
+    w.dataset(g, "cycle", np.array([c.cycle for c in cs], dtype="i8"), units="cycles",
+              long_name="the accepted state the run coarsened at and went on from")
+    w.dataset(g, "factor", np.array([c.factor for c in cs], dtype="i8"), units="1",
+              long_name="the run's element along x after it, in elements of /grid")
+    w.dataset(g, "elements_x", np.array([c.elements[0] for c in cs], dtype="i8"), units="1",
+              long_name="the run's elements along x after it")
+    w.dataset(g, "reason", [c.reason for c in cs], h5py.string_dtype())
 
 
 def _fsync_dir(directory: Path) -> None:
