@@ -358,6 +358,8 @@ def _simulate(counter, sink: _Sink, observers, progress, state, runs: SideRuns) 
             state, why = _widen(exc, counter, sink, runs, state)
             if state is None:
                 return "failed", _unwidened(exc, sink.setup.grid, why)
+            if state is _FROM_START:
+                state = None
         except regrid.Coarsen as exc:
             state = _coarsen(exc, counter, sink, runs)
 
@@ -394,16 +396,19 @@ def _unwidened(exc: DomainError, grid, why: str) -> str:
             f"{extent:.4g} mm) and {why}; give grid.domain and grid.elements for a domain that holds the scar")
 
 
-def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns,
-           resumed: Optional[dict]) -> tuple[Optional[dict], str]:
+_FROM_START = object()  # _widen's state where the first solve reached the edge: the run starts again, wider
+
+
+def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns, resumed: Optional[dict]):
     """The last step's state (or the one the run was ``resumed`` from, before its first step) on a grid widened
-    where the contact reached its edge, the run's setup and its results file moved onto it; None where the grid
-    may not or cannot grow (the user's grid, too many widenings, nothing to go back to, a grid the planner
-    refuses), with why an automatic grid was not widened ("" for the user's grid, or nothing to go back to).
-    The widening is one of the run's notes (as the refusals are), so `fretsim run` prints it after the plan's."""
+    where the contact reached its edge, the run's setup and its results file moved onto it (_FROM_START where the
+    first solve reached it: a crowned roller's contact is wider than the straight one the grid was sized for);
+    None where the grid may not or cannot grow (the user's grid, too many widenings, a grid the planner refuses),
+    with why an automatic grid was not widened ("" for the user's grid).  The widening is one of the run's notes
+    (as the refusals are), so `fretsim run` prints it after the plan's."""
     setup, filled, plan = sink.setup, sink.filled, sink.plan
     base = counter.last.state if counter.last is not None else resumed
-    if not regrid.grid_is_automatic(plan) or not base:
+    if not regrid.grid_is_automatic(plan):
         return None, ""
     if len(sink.regrids) >= regrid.MAX_REGRIDS:
         times = f"{regrid.MAX_REGRIDS} time{'s' if regrid.MAX_REGRIDS != 1 else ''}"
@@ -411,7 +416,7 @@ def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns,
                f"beyond its estimate")
         counter.notes.append(why)
         return None, why
-    run_r = regrid.widened(setup.grid, exc.axis, setup.band, int(base["n"]),
+    run_r = regrid.widened(setup.grid, exc.axis, setup.band, int(base["n"]) if base else 0,
                            f"the contact reached the {exc.axis} edge at cycle {exc.cycle}")
     r = regrid.scaled(run_r, sink.factor)  # the output grid's widening (the same where the grid never coarsened)
     plane = setup.grid.plane_strain
@@ -427,7 +432,7 @@ def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns,
         why = f"the automatic grid could not be widened: {str(err).splitlines()[-1][:200]}"
         counter.notes.append(why)
         return None, why
-    state = regrid.pad_state(base, run_r)
+    state = regrid.pad_state(base, run_r) if base else None
     if counter.last is not None:
         counter.last = regrid.pad_record(counter.last, run_r)
     note = regrid.describe(r)
@@ -440,7 +445,7 @@ def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns,
                 regrid.replanned(plan, r, plane), state, note)
     if sink.factor > 1:
         sink.follow(dataclasses.replace(run_setup, per_cycle=setup.per_cycle), run_filled)  # (regrid.step_down)
-    return state, ""
+    return (state if base else _FROM_START), ""
 
 
 def _simulate_on(setup, plan, counter, sink: _Sink, observers, progress, state) -> tuple[str, str]:
