@@ -18,9 +18,16 @@ import traceback
 from typing import Optional
 from pathlib import Path
 
-import click
+# One BLAS thread, as the house runs one thread per solve: numpy's dots here are small (the norms of a grid's
+# fields), and OpenBLAS's second thread, on a machine whose other core is busy (two runs, a shell sweep, a test
+# suite), made the 3D tube in service 3.1x slower (8.75 s against 2.82 s, scripts/results/bench_blas_threads.txt).  Set
+# before numpy loads (the commands import it when they run), and only where the user has not set it.
+for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
+    os.environ.setdefault(_var, "1")
 
-from fretsim.errors import InputError, ResultsFileError
+import click  # noqa: E402
+
+from fretsim.errors import InputError, ResultsFileError  # noqa: E402
 
 EXIT_BAD_INPUT = 2
 EXIT_FAILED = 3
@@ -933,10 +940,7 @@ def sweep(sweep_file: Path, outdir: Path, jobs: int, dask_address: str | None, o
     Re-running skips complete points and resumes interrupted ones.  Exit 0 when every point completed, 3 when
     some failed or were refused (see DIR/table.csv), 2 for a bad sweep file, 5 when the disk refused a point's
     results or the table, 130 interrupted."""
-    import os
-    for var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):  # before numpy loads: one BLAS
-        os.environ.setdefault(var, "1")                                        # thread per worker
-    from fretsim.sweep import load_sweep, run_sweep
+    from fretsim.sweep import load_sweep, run_sweep  # (one BLAS thread per worker: set at the module's top)
 
     if dask_address:
         from fretsim.sweep import check_dask_address

@@ -241,10 +241,18 @@ def coarsened_record(record, grid: Grid, pad_r: Optional[Regrid]):
     return dataclasses.replace(record, **changes)
 
 
+def along_x(case, grid: Grid, extent: float, nx: int):
+    """The case on ``nx`` elements over ``extent`` (mm) along x, its rows across (3D) as on ``grid``."""
+    if grid.plane_strain:
+        return case.with_choices(domain=(extent,), elements=(nx,))
+    ny = grid.shape[0]
+    return case.with_choices(domain=(extent, ny * grid.dy), elements=(nx, ny))
+
+
 def coarse_case(case, grid: Grid, pad_r: Optional[Regrid]):
     """The case (its grid automatic, its choices filled) on the merged grid."""
     n = pad_r.new_elements[0] if pad_r is not None else grid.shape[1]
-    return case.with_choices(domain=(n * grid.dx,), elements=(n // COARSEN,))
+    return along_x(case, grid, n * grid.dx, n // COARSEN)
 
 
 @dataclass(frozen=True)
@@ -254,23 +262,22 @@ class CoarsenRule:
 
     accuracy: float  # grid.rule accuracy's model.accuracy
     pressure_accuracy: Optional[float]
-    lightest_load: float  # N per mm in 2D: the load the contact is narrowest under
-    volume_factor: float  # the line length: a 2D pressure integral to N
+    lightest_load: float  # N (N per mm in 2D): the load the contact is narrowest under
+    volume_factor: float  # the line length in 2D (a pressure integral to N), 1 in 3D
 
     def __call__(self, setup, step) -> Optional[str]:
         if step.cycle == 0:
             return None
         from fretsim import measures, sizing
         grid = setup.grid
-        p = step.pressure[0]
-        inside = np.flatnonzero(p > 0)
+        inside = np.flatnonzero((step.pressure > 0).any(axis=0))
         if inside.size == 0:
             return None
         half = 0.5 * (inside[-1] - inside[0] + 1) * grid.dx
-        load = float(p.sum()) * grid.dx
+        load = float(step.pressure.sum()) * grid.area
         # a heavier block's contact is wider than the lightest's: scaled as a Hertz line contact (√P)
         half *= min(1.0, math.sqrt(self.lightest_load / load)) if load > 0 else 1.0
-        width = measures.scar_width(step.wear_stationary[0], grid.x) or 2 * half
+        width = measures.centre_width(step.wear_stationary, grid.x) or 2 * half
         allowed = [(7 * half / sizing.ELEMENTS_OVER_7A, f"7c/40 of the contact half-width c {half * 1e3:.4g} µm"),
                    (self.accuracy * width / sizing.WIDTH_SHARE,
                     f"a third of model.accuracy of the scar width {width * 1e3:.4g} µm")]
@@ -287,11 +294,13 @@ class CoarsenRule:
 
 def rule_for(case, setup, plan, accuracy: Optional[float] = None) -> Optional[CoarsenRule]:
     """The coarsening rule of a run planned as ``plan``, None where its grid may not coarsen: the user's grid, the
-    paper's rule asked for (grid.rule paper; a pilot passes the run's ``accuracy``), 3D, refinement's coarse grid,
-    a grid refined for partial slip (its stick zone needs the elements), fatigue."""
+    paper's rule asked for (grid.rule paper; a pilot passes the run's ``accuracy``), a point contact in 3D (its
+    scar grows along y too; a line contact's rows stay), refinement's coarse grid, a grid refined for partial slip
+    (its stick zone needs the elements), fatigue."""
     accuracy = accuracy if accuracy is not None else case.accuracy if case.grid_rule == "accuracy" else None
     refined = any(c.key == "grid.elements" and "partial slip" in c.reason for c in plan.choices)
-    if (accuracy is None or not grid_is_automatic(plan) or not setup.grid.plane_strain or setup.coarse is not None
+    line = setup.grid.plane_strain or setup.y_edges_free
+    if (accuracy is None or not grid_is_automatic(plan) or not line or setup.coarse is not None
             or refined or setup.fatigue_specs or case.loading.cycles == 0):
         return None
     return CoarsenRule(accuracy, case.pressure_accuracy, case.loading.lightest_load / setup.volume_factor,
