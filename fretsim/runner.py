@@ -12,6 +12,7 @@ import threading
 import time
 from dataclasses import dataclass, field
 from pathlib import Path
+from types import SimpleNamespace
 from typing import Callable, Optional
 
 import numpy as np
@@ -353,6 +354,7 @@ def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from:
 def _simulate(counter, sink: _Sink, observers, progress, state, runs: SideRuns) -> tuple[str, str]:
     """The loop, its ending as a status and a message (a grid that cannot resolve the contact is bad input); an
     automatic grid the contact outgrows is widened and the loop goes on from its last step (:mod:`fretsim.regrid`)."""
+    state = _resumed_coarsening(counter, sink, state, runs)
     while True:
         try:
             return _simulate_on(sink.setup, sink.plan, counter, sink, observers, progress, state)
@@ -364,6 +366,21 @@ def _simulate(counter, sink: _Sink, observers, progress, state, runs: SideRuns) 
                 state = None
         except regrid.Coarsen as exc:
             state = _coarsen(exc, counter, sink, runs)
+
+
+def _resumed_coarsening(counter, sink: _Sink, state: Optional[dict], runs: SideRuns) -> Optional[dict]:
+    """A resumed run's checkpoint, on the coarser grid where its rule allows it there.  The loop asks the rule only
+    after a step it takes, so a run interrupted at the step that allowed a coarsening (its observers had the step,
+    the re-planning was not done) would otherwise coarsen a step later than the uninterrupted run did."""
+    if state is None or sink.rule is None or "limit_key" in state:
+        return state
+    n = int(state["n"])
+    if not 0 < n < sink.setup.cycles or any(c.cycle == n for c in sink.coarsenings):  # (already coarsened here)
+        return state
+    # what the rule and the merge read of a step: its pressure and wear are the checkpoint's (Step from emit)
+    step = SimpleNamespace(cycle=n, state=state, pressure=state["p"], wear_stationary=state["h_s"])
+    why = sink.rule(sink.setup, step)
+    return _coarsen(regrid.Coarsen(step, why), counter, sink, runs) if why else state
 
 
 def _coarsen(exc: "regrid.Coarsen", counter, sink: _Sink, runs: SideRuns) -> dict:

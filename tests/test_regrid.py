@@ -253,3 +253,40 @@ def test_the_grid_error_companions_coarsen_where_the_run_did():
     # its estimate is of the grids the run used: the run on them against the companion at twice their element
     assert 0 < out.summary["estimated_error_width"] < 0.01
     assert math.isfinite(out.summary["estimated_error_cycles_to_limit"])
+
+
+def _same_results(a, b) -> None:
+    assert b.coarsenings == a.coarsenings
+    for name in ("cycle", "wear_depth_stationary", "wear_depth_moving", "pressure"):
+        np.testing.assert_array_equal(b.fields[name], a.fields[name], err_msg=name)
+    for key in ("cycle", "max_wear_depth_moving", "wear_volume_stationary"):
+        np.testing.assert_array_equal(b.history[key], a.history[key], err_msg=key)
+    assert b.summary["cycles_to_limit"] == a.summary["cycles_to_limit"]
+
+
+@pytest.mark.parametrize("where", ["at_the_step", "in_the_replanning"])
+def test_a_run_interrupted_at_the_step_that_coarsens_resumes_bit_for_bit(tmp_path, monkeypatch, where):
+    """The loop asks the rule only after a step it takes: a Ctrl-C at the step that allowed the coarsening (an
+    observer's, or one during the coarser grid's planning) left the fine state of that step, and the resumed run
+    coarsened one step later (cycles to the limit 1.3e-4 off)."""
+    import fretsim.runner as runner
+    from conftest import StopAt
+    run(load_case(TUBE, TUBE_SETS), tmp_path / "whole.h5")
+    a = read_results(tmp_path / "whole.h5")
+    first = a.coarsenings[0]
+    if where == "at_the_step":
+        observers = (StopAt(first.cycle),)
+    else:
+        real, observers = runner.prepare, ()
+
+        def ctrl_c(case, **kw):
+            if case.elements is not None and case.elements[0] == first.elements[0]:
+                raise KeyboardInterrupt
+            return real(case, **kw)
+        monkeypatch.setattr(runner, "prepare", ctrl_c)
+    with pytest.raises(KeyboardInterrupt):
+        run(load_case(TUBE, TUBE_SETS), tmp_path / "cut.h5", observers=observers)
+    monkeypatch.undo()
+    assert read_results(tmp_path / "cut.h5").checkpoint["n"] == first.cycle
+    resume(tmp_path / "cut.h5")
+    _same_results(a, read_results(tmp_path / "cut.h5"))
