@@ -62,6 +62,12 @@ class Regrid:
         return (self.new_elements[1] - self.old_elements[1]) // 2, (self.new_elements[0] - self.old_elements[0]) // 2
 
 
+def widenings(regrids) -> int:
+    """The widenings among ``regrids`` (/regrids rows): not the paddings a coarsening makes, a few elements each,
+    which MAX_REGRIDS does not count."""
+    return sum(not r.reason.startswith("padded") for r in regrids)
+
+
 def grid_is_automatic(plan) -> bool:
     """Neither grid.domain nor grid.elements given in the case (nor read back as given on a resume)."""
     return not any(c.given for c in plan.choices if c.key in ("grid.domain", "grid.elements"))

@@ -429,7 +429,7 @@ def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns, resumed: Opti
     base = counter.last.state if counter.last is not None else resumed
     if not regrid.grid_is_automatic(plan):
         return None, ""
-    if len(sink.regrids) >= regrid.MAX_REGRIDS:
+    if regrid.widenings(sink.regrids) >= regrid.MAX_REGRIDS:
         times = f"{regrid.MAX_REGRIDS} time{'s' if regrid.MAX_REGRIDS != 1 else ''}"
         why = (f"the automatic grid was widened {times}, the most allowed: the scar outgrew the planned one far "
                f"beyond its estimate")
