@@ -358,8 +358,13 @@ def following(run: Callable, setup, case, rule: Callable, prepare_fn: Callable):
 
 def scaled(r: Regrid, factor: int) -> Regrid:
     """A widening of the run's grid (elements ``factor`` output elements long) as one of the output grid."""
+    n = r.new_elements[0] * factor
+    reason = r.reason
+    if factor > 1 and reason.startswith("padded"):  # its count is of the run's elements: the row's are the output's
+        reason = (f"padded to {n} elements ({r.new_elements[0]} of the run's, each {factor} of them) to merge them "
+                  f"{COARSEN} to 1")
     return dataclasses.replace(r, old_elements=(r.old_elements[0] * factor,) + r.old_elements[1:],
-                               new_elements=(r.new_elements[0] * factor,) + r.new_elements[1:])
+                               new_elements=(n,) + r.new_elements[1:], reason=reason)
 
 
 def describe_coarsening(c: Coarsening, old_elements: int) -> str:

@@ -310,3 +310,15 @@ def test_the_paddings_of_coarsenings_do_not_count_as_widenings(tmp_path, monkeyp
     assert padded and len(r.coarsenings) >= 2
     assert out.status == "complete", out.message
     assert len(r.regrids) - len(padded) <= regrid.MAX_REGRIDS
+
+
+def test_a_padding_row_names_the_elements_it_pads_to():
+    """/regrids rows are in elements of /grid; a padding made on a coarsened grid said the run's count ("8955 →
+    8991 elements (padded to 999 elements ...)") in the row and in the grid choices' reasons."""
+    import fretsim.regrid as regrid
+    from fretsim.grid import Grid
+    pad_r = regrid.padding(Grid.centred(995, 1, 9.0, 1.0, True), 7)
+    r = regrid.scaled(pad_r, 9)
+    assert r.new_elements[0] == 8991 and r.reason.startswith("padded to 8991 elements")
+    assert f"→ 8991 elements" in regrid.describe(r) and "padded to 999 " not in regrid.describe(r)
+    assert regrid.widenings([r]) == 0
