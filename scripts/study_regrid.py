@@ -13,8 +13,8 @@ Prints a table; writes scripts/out/regrid.txt.
 Coarsening (issue 32, second part): the tubes in service to their wall limit, each run whole (the pilot, the run,
 its grid-error companions, the results file) with the grid coarsened as the scar grows and with coarsening off
 (``fretsim.regrid.rule_for`` returning None everywhere: the previous tree's computation, which
-scripts/compare_trees.py shows bit for bit equal on every case that does not coarsen), alternately, REPEATS times
-each; medians and their ratio, and whether the cycles and years to the limit, the wall loss and the scar width of
+scripts/compare_trees.py shows bit for bit equal on every case that does not coarsen), alternately, five times
+each (the 3D tube once: its fine run takes over a minute); medians and their ratio, and whether the cycles and years to the limit, the wall loss and the scar width of
 each lie within the other's estimated error.
 
     python scripts/study_regrid.py --coarsen      # writes scripts/results/regrid_coarsen.txt
@@ -40,8 +40,8 @@ KEYS = (("depth", "max_wear_depth_stationary_um"), ("width", "scar_width_station
         ("volume", "wear_volume_stationary_mm3"))
 
 
-COARSEN_CASES = ("tube_service_RT", "tube_service_90C")
-REPEATS = 5
+COARSEN_CASES = (("tube_service_RT", [], 5), ("tube_service_90C", [], 5),
+                 ("tube_service_RT", ["model.dimension=3d"], 1))  # (case, overrides, timed repeats)
 COMPARED = (("cycles_to_limit", "estimated_error_cycles_to_limit", "cycles to limit"),
             ("max_wear_depth_moving_um", "estimated_error_depth", "wall loss µm"),
             ("scar_width_stationary_mm", "estimated_error_width", "flat's scar mm"))
@@ -53,14 +53,15 @@ def coarsen() -> None:
     import fretsim.regrid as regrid
     say = Report()
     real = regrid.rule_for
-    say(f"{'case':<18}{'side':<11}{'whole s':>9}{'loop s':>8}{'comp s':>8}{'solves':>8}{'final grid':>12}"
+    say(f"{'case':<21}{'side':<11}{'whole s':>9}{'loop s':>8}{'comp s':>8}{'solves':>8}{'final grid':>12}"
         f"{'cycles to limit':>18}{'years':>8}{'wall loss µm':>14}{'scar mm':>9}")
-    for name in COARSEN_CASES:
-        case = load_case(ROOT / "cases" / f"{name}.yaml")
+    for name, sets, repeats in COARSEN_CASES:
+        case = load_case(ROOT / "cases" / f"{name}.yaml", sets)
+        name = " ".join([name] + [s.split("=")[1].upper() for s in sets])
         times: dict = {"coarsened": [], "fine": []}
         outs: dict = {}
         with tempfile.TemporaryDirectory() as tmp:
-            for i in range(REPEATS + 1):  # the first pair untimed: the caches' warm-up
+            for i in range(repeats + 1):  # the first pair untimed: the caches' warm-up
                 for side in ("coarsened", "fine"):
                     regrid.rule_for = real if side == "coarsened" else (lambda *a, **k: None)
                     try:
@@ -73,12 +74,12 @@ def coarsen() -> None:
         for side in ("fine", "coarsened"):
             o, m = outs[side], statistics.median(times[side])
             s = o.summary
-            say(f"{name:<18}{side:<11}{m:>9.2f}{s['wall_time_s']:>8.2f}{s['grid_error_wall_time_s']:>8.2f}"
+            say(f"{name:<21}{side:<11}{m:>9.2f}{s['wall_time_s']:>8.2f}{s['grid_error_wall_time_s']:>8.2f}"
                 f"{s['contact_solves']:>8}{o.setup.grid.shape[1]:>12}{s['cycles_to_limit']:>18,.0f}"
                 f"{s['time_to_limit_h'] / 8766:>8.4f}{s['max_wear_depth_moving_um']:>14.4f}"
                 f"{s['scar_width_stationary_mm']:>9.4f}")
         ratio = statistics.median(times["fine"]) / statistics.median(times["coarsened"])
-        say(f"    whole run {ratio:.2f}× faster coarsened (medians of {REPEATS}, alternating); "
+        say(f"    whole run {ratio:.2f}× faster coarsened (medians of {repeats}, alternating); "
             f"loop {outs['fine'].summary['wall_time_s'] / outs['coarsened'].summary['wall_time_s']:.2f}×, "
             f"companions {outs['fine'].summary['grid_error_wall_time_s'] / outs['coarsened'].summary['grid_error_wall_time_s']:.2f}×")
         for key, err, label in COMPARED:
