@@ -230,7 +230,10 @@ def coarsened_state(state: dict, grid: Grid, pad_r: Optional[Regrid]) -> dict:
 
 
 def coarsened_record(record, grid: Grid, pad_r: Optional[Regrid]):
-    """A step (or a cycle) with its arrays on the coarser grid (what is reported of the last state before it)."""
+    """A step (or a cycle) with its arrays on the coarser grid (what is reported of the last state before it); its
+    state is the one the run goes on from (:func:`coarsened_state`), which a widening at the next step goes back
+    to."""
+    state = getattr(record, "state", None)
     if pad_r is not None:
         record = pad_record(record, pad_r)
     shape = (grid.shape[0], pad_r.new_elements[0] if pad_r is not None else grid.shape[1])
@@ -242,8 +245,8 @@ def coarsened_record(record, grid: Grid, pad_r: Optional[Regrid]):
                                                                   grid.plane_strain), None)
         elif isinstance(value, np.ndarray):
             changes[f.name] = merge(value, shape)
-        elif f.name == "state" and isinstance(value, dict):
-            changes[f.name] = {k: merge(v, shape) for k, v in value.items()}
+        elif f.name == "state" and isinstance(state, dict):
+            changes[f.name] = coarsened_state(state, grid, pad_r)
     return dataclasses.replace(record, **changes)
 
 

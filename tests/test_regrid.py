@@ -356,3 +356,27 @@ def test_a_point_contact_is_never_coarsened():
     import fretsim.regrid as regrid
     setup, filled, plan = prepare(load_case(CASE.parent / "seat_rail.yaml"))
     assert regrid.rule_for(filled, setup, plan) is None
+
+
+def test_the_last_step_kept_across_a_coarsening_holds_the_state_the_run_goes_on_from():
+    """A widening at the first step after a coarsening goes back to the last step's state (the runner's
+    ``counter.last``): it kept the fine grid's growth watch, which the coarsened state starts afresh (an odd-even
+    amplitude is not comparable across grids), so the run went on from another state than a resume from the same
+    cycle would."""
+    from dataclasses import dataclass
+    import fretsim.regrid as regrid
+    from fretsim.grid import Grid
+
+    @dataclass
+    class Record:
+        pressure: np.ndarray
+        state: dict
+
+    grid = Grid.centred(7, 1, 1.0, 1.0, True)
+    state = {"n": 5, "h_m": np.arange(7.0)[None, :], "watch": np.array([1e-3, 2e-3, 4e-3])}
+    pad_r = regrid.padding(grid, 5)
+    kept = regrid.coarsened_record(Record(np.ones((1, 7)), state), grid, pad_r).state
+    goes_on = regrid.coarsened_state(state, grid, pad_r)
+    assert kept.keys() == goes_on.keys()
+    for key in goes_on:
+        np.testing.assert_array_equal(kept[key], goes_on[key], err_msg=key)
