@@ -454,6 +454,9 @@ def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns, resumed: Opti
     if counter.last is not None:
         counter.last = regrid.pad_record(counter.last, run_r)
     note = regrid.describe(r)
+    if sink.factor > 1:  # (in elements of /grid, as /regrids is; the coarsening notes count the run's)
+        note += (f"; {run_r.old_elements[0]} → {run_r.new_elements[0]} of the run's, each {sink.factor} of "
+                 f"these")
     if setup.coarse is not None and new_setup.coarse is not None:  # refinement: not nested, so not exact
         note += (f"; the coarse grid of refinement is re-derived on the wider domain, its element "
                  f"{setup.coarse.dx * 1e3:.4g} → {new_setup.coarse.dx * 1e3:.4g} µm, so from here the pressure is "

@@ -380,3 +380,21 @@ def test_the_last_step_kept_across_a_coarsening_holds_the_state_the_run_goes_on_
     assert kept.keys() == goes_on.keys()
     for key in goes_on:
         np.testing.assert_array_equal(kept[key], goes_on[key], err_msg=key)
+
+
+def test_a_widening_of_a_coarsened_grid_says_how_many_elements_the_run_has(monkeypatch):
+    """The widening's note counts elements of the results' /grid; after a coarsening the run has a third (a ninth,
+    ...) of them, which the coarsening notes count: "coarsened: 1815 → 605", then "widened: 1815 → 2907", then
+    "coarsened: 969 → 323" read as if the run had gone back to the fine grid."""
+    real = plan_grid.auto_grid
+
+    def small(*args, **kw):
+        if kw.get("volume") is not None:
+            kw["volume"] = kw["volume"] / 300
+        return real(*args, **kw)
+    monkeypatch.setattr(plan_grid, "auto_grid", small)
+    out = run(load_case(TUBE, TUBE_SETS))
+    assert out.status == "complete", out.message
+    coarse_widened = [n for n in out.notes if "widened along x" in n and "1815 → 2907" in n]
+    assert coarse_widened, out.notes
+    assert "605 → 969 of the run's" in coarse_widened[0]
