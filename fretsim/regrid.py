@@ -250,18 +250,21 @@ def coarsened_record(record, grid: Grid, pad_r: Optional[Regrid]):
     return dataclasses.replace(record, **changes)
 
 
-def along_x(case, grid: Grid, extent: float, nx: int):
-    """The case on ``nx`` elements over ``extent`` (mm) along x, its rows across (3D) as on ``grid``."""
-    if grid.plane_strain:
-        return case.with_choices(domain=(extent,), elements=(nx,))
-    ny = grid.shape[0]
-    return case.with_choices(domain=(extent, ny * grid.dy), elements=(nx, ny))
+def along_x(case, grid: Grid, nx: int, extent: Optional[float] = None):
+    """The case on ``nx`` elements along x over ``extent`` (mm; None: the case's own domain, bit for bit), its rows
+    across (3D) as on ``grid``."""
+    rows = () if grid.plane_strain else (grid.shape[0],)
+    if extent is None:
+        return case.with_choices(elements=(nx,) + rows)
+    return case.with_choices(domain=(extent,) + tuple(case.domain[1:2] if rows else ()), elements=(nx,) + rows)
 
 
 def coarse_case(case, grid: Grid, pad_r: Optional[Regrid]):
-    """The case (its grid automatic, its choices filled) on the merged grid."""
+    """The case (its grid automatic, its choices filled) on the merged grid.  Its domain is the case's, or the
+    padding's (both the output grid's too): a resume plans the run's grid from the output grid's domain, which n·dx
+    of a grid planned as domain/n may miss by its last bit."""
     n = pad_r.new_elements[0] if pad_r is not None else grid.shape[1]
-    return along_x(case, grid, n * grid.dx, n // COARSEN)
+    return along_x(case, grid, n // COARSEN, pad_r.new_domain[0] if pad_r is not None else None)
 
 
 @dataclass(frozen=True)

@@ -199,7 +199,7 @@ def resume(output: str | Path, *, progress: Optional[Callable[[int], None]] = No
         if previous.coarsenings:  # on the grid the run had coarsened to, from its checkpoint's coarse elements
             factor = sink.factor
             g = setup.grid
-            run_setup, run_filled, _ = prepare(regrid.along_x(filled, g, g.shape[1] * g.dx, g.shape[1] // factor),
+            run_setup, run_filled, _ = prepare(regrid.along_x(filled, g, g.shape[1] // factor),
                                                runs=runs)
             sink.follow(dataclasses.replace(run_setup, per_cycle=setup.per_cycle), run_filled)  # (regrid.step_down)
             previous = dataclasses.replace(previous, checkpoint={
@@ -242,8 +242,8 @@ class _Sink:
         self.open(self.overwrite)
         if pad_r is not None:
             r_out = regrid.scaled(pad_r, self.factor)
-            out_setup, out_filled, _ = prepare(regrid.along_x(self.filled, self.out_grid, r_out.new_domain[0],
-                                                              r_out.new_elements[0]), runs=runs)
+            out_setup, out_filled, _ = prepare(regrid.along_x(self.filled, self.out_grid, r_out.new_elements[0],
+                                                              r_out.new_domain[0]), runs=runs)
             self.regrids.append(r_out)
             self.out_grid, self.filled = out_setup.grid, out_filled
             self.plan = regrid.replanned(plan, r_out, self.out_grid.plane_strain)
@@ -444,8 +444,8 @@ def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns, resumed: Opti
     try:
         new_setup, new_filled, _ = prepare(wider, runs=runs)
         if sink.factor > 1:
-            run_setup, run_filled, _ = prepare(regrid.along_x(sink.run_filled, setup.grid, run_r.new_domain[0],
-                                                              run_r.new_elements[0]), runs=runs)
+            run_setup, run_filled, _ = prepare(regrid.along_x(sink.run_filled, setup.grid, run_r.new_elements[0],
+                                                              run_r.new_domain[0]), runs=runs)
     except CaseError as err:  # e.g. more memory than the machine has
         why = f"the automatic grid could not be widened: {str(err).splitlines()[-1][:200]}"
         counter.notes.append(why)
