@@ -400,7 +400,11 @@ def _coarsen(exc: "regrid.Coarsen", counter, sink: _Sink, runs: SideRuns) -> dic
         counter.last = regrid.coarsened_record(counter.last, setup.grid, pad_r)
     note = regrid.describe_coarsening(made, setup.grid.shape[1])
     counter.notes.append(note)
-    sink.coarsen(made, pad_r, new_setup, run_filled, sink.plan, state, note, runs)
+    held = _ignore_signals()  # the file's grid, fields and checkpoint move together: a Ctrl-C between them would
+    try:                      # write a checkpoint of one grid beside fields of another
+        sink.coarsen(made, pad_r, new_setup, run_filled, sink.plan, state, note, runs)
+    finally:
+        _restore_signals(held)
     return state
 
 
@@ -462,10 +466,14 @@ def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns, resumed: Opti
                  f"{setup.coarse.dx * 1e3:.4g} → {new_setup.coarse.dx * 1e3:.4g} µm, so from here the pressure is "
                  f"solved on slightly different coarse elements")
     counter.notes.append(note)
-    sink.regrid(r, dataclasses.replace(new_setup, notes=tuple(setup.notes)), new_filled,
-                regrid.replanned(plan, r, plane), state, note)
-    if sink.factor > 1:
-        sink.follow(dataclasses.replace(run_setup, per_cycle=setup.per_cycle), run_filled)  # (regrid.step_down)
+    held = _ignore_signals()  # as in _coarsen: the grid, fields and checkpoint move together
+    try:
+        sink.regrid(r, dataclasses.replace(new_setup, notes=tuple(setup.notes)), new_filled,
+                    regrid.replanned(plan, r, plane), state, note)
+        if sink.factor > 1:
+            sink.follow(dataclasses.replace(run_setup, per_cycle=setup.per_cycle), run_filled)  # (regrid.step_down)
+    finally:
+        _restore_signals(held)
     return (state if base else _FROM_START), ""
 
 
@@ -645,8 +653,9 @@ def _coarsest(case: Case, runs: SideRuns, replay: tuple = ()) -> Optional[dict]:
     try:
         c_setup, c_filled, _ = prepare(case, runs=runs)
         last, c_setup = _side_run(runs, f"grid error: the case again on a grid four times as coarse "
-                                        f"({c_setup.grid.shape[1]} × {c_setup.grid.shape[0]} elements) to see "
-                                        f"whether the peak pressure converges", c_setup, c_filled, replay)
+                                        f"({c_setup.grid.shape[1]} × {c_setup.grid.shape[0]} elements"
+                                        f"{', coarsened where the run was' if replay else ''}) to see whether the "
+                                        f"peak pressure converges", c_setup, c_filled, replay)
         return summarize(c_setup, last, 0, 0.0)
     except (SimulationError, CaseError):
         return None
