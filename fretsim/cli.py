@@ -19,9 +19,9 @@ from typing import Optional
 from pathlib import Path
 
 # One BLAS thread, as the house runs one thread per solve: numpy's dots here are small (the norms of a grid's
-# fields), and OpenBLAS's second thread, on a machine whose other core is busy (two runs, a shell sweep, a test
-# suite), made the 3D tube in service 3.1x slower (8.75 s against 2.82 s, scripts/results/bench_blas_threads.txt).  Set
-# before numpy loads (the commands import it when they run), and only where the user has not set it.
+# fields), and OpenBLAS's second thread made whole 3D runs 4 % slower on a quiet machine and 1.5x slower with the
+# other core busy (two runs, a shell sweep; scripts/results/bench_blas_threads.txt).  Set before numpy loads (the
+# commands import it when they run), and only where the user has not set it.
 for _var in ("OMP_NUM_THREADS", "OPENBLAS_NUM_THREADS", "MKL_NUM_THREADS"):
     os.environ.setdefault(_var, "1")
 
