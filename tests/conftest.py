@@ -203,17 +203,22 @@ def same(a, b) -> bool:
     return a == b or (a != a and b != b)
 
 
-@pytest.fixture
-def underestimated(monkeypatch):
-    """The automatic grid sized for a thirtieth of the worn volume the run will reach (so that it is widened);
+def underestimate(monkeypatch, factor: float):
+    """The automatic grid sized for 1/``factor`` of the worn volume the run will reach (so that it is widened);
     the real sizing returned, to put back."""
     import fretsim.plan.grid as plan_grid
     real = plan_grid.auto_grid
 
     def small(*args, **kw):
         if kw.get("volume") is not None:
-            kw["volume"] = kw["volume"] / 30
+            kw["volume"] = kw["volume"] / factor
         return real(*args, **kw)
 
     monkeypatch.setattr(plan_grid, "auto_grid", small)
     return real
+
+
+@pytest.fixture
+def underestimated(monkeypatch):
+    """:func:`underestimate` by 30."""
+    return underestimate(monkeypatch, 30)

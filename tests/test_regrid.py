@@ -298,13 +298,8 @@ def test_the_paddings_of_coarsenings_do_not_count_as_widenings(tmp_path, monkeyp
     the MAX_REGRIDS widenings (each 1.6× the extent), a tube whose scar the planner underestimated 1e5 times in
     volume stopped "widened 6 times, the most allowed" after four."""
     import fretsim.regrid as regrid
-    real = plan_grid.auto_grid
-
-    def small(*args, **kw):
-        if kw.get("volume") is not None:
-            kw["volume"] = kw["volume"] / 1e5
-        return real(*args, **kw)
-    monkeypatch.setattr(plan_grid, "auto_grid", small)
+    from conftest import underestimate
+    underestimate(monkeypatch, 1e5)
     out = run(load_case(TUBE, TUBE_SETS), tmp_path / "r.h5")
     r = read_results(tmp_path / "r.h5")
     padded = [g for g in r.regrids if g.reason.startswith("padded")]
@@ -386,13 +381,8 @@ def test_a_widening_of_a_coarsened_grid_says_how_many_elements_the_run_has(monke
     """The widening's note counts elements of the results' /grid; after a coarsening the run has a third (a ninth,
     ...) of them, which the coarsening notes count: "coarsened: 1815 → 605", then "widened: 1815 → 2907", then
     "coarsened: 969 → 323" read as if the run had gone back to the fine grid."""
-    real = plan_grid.auto_grid
-
-    def small(*args, **kw):
-        if kw.get("volume") is not None:
-            kw["volume"] = kw["volume"] / 300
-        return real(*args, **kw)
-    monkeypatch.setattr(plan_grid, "auto_grid", small)
+    from conftest import underestimate
+    underestimate(monkeypatch, 300)
     out = run(load_case(TUBE, TUBE_SETS))
     assert out.status == "complete", out.message
     coarse_widened = [n for n in out.notes if "widened along x" in n and "1815 → 2907" in n]
