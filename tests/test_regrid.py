@@ -316,7 +316,7 @@ def test_a_padding_row_names_the_elements_it_pads_to():
     pad_r = regrid.padding(Grid.centred(995, 1, 9.0, 1.0, True), 7)
     r = regrid.scaled(pad_r, 9)
     assert r.new_elements[0] == 8991 and r.reason.startswith("padded to 8991 elements")
-    assert f"→ 8991 elements" in regrid.describe(r) and "padded to 999 " not in regrid.describe(r)
+    assert "→ 8991 elements" in regrid.describe(r) and "padded to 999 " not in regrid.describe(r)
     assert regrid.widenings([r]) == 0
 
 
