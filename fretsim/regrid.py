@@ -26,8 +26,9 @@ worn volumes (and the forces) carry over to round-off.  The results keep the fin
 constant: the same volume), the checkpoint too (and read back by taking each coarse element's middle fine one,
 bit for bit), and ``/coarsenings`` records when, to what and why, so that a resume goes on on the same coarse
 grid.  The grid-error companions replay the run's coarsenings at the same cycles, so their estimate covers the
-grids the run used.  Only 2D runs coarsen (a point contact would need y too, a line contact's rows are its ends),
-and not with refinement's coarse grid, partial slip's refined grid, or fatigue (its damage lives on its own grid).
+grids the run used.  Elements merge along x only: 2D runs and 3D line contacts coarsen (a line contact's rows are
+its ends, and stay), a point contact does not (its scar grows along y too); nor do refinement's coarse grid,
+partial slip's refined grid, or fatigue (its damage lives on its own grid).
 """
 from __future__ import annotations
 
@@ -269,13 +270,12 @@ def coarse_case(case, grid: Grid, pad_r: Optional[Regrid]):
 
 @dataclass(frozen=True)
 class CoarsenRule:
-    """When a 2D run's state allows elements COARSEN times as long: both rules that sized the automatic grid hold
-    for the longer element on the current contact and scar (:mod:`fretsim.sizing`)."""
+    """When a run's state allows elements COARSEN times as long along x: both rules that sized the automatic grid
+    hold for the longer element on the current contact and scar (:mod:`fretsim.sizing`)."""
 
     accuracy: float  # grid.rule accuracy's model.accuracy
     pressure_accuracy: Optional[float]
     lightest_load: float  # N (N per mm in 2D): the load the contact is narrowest under
-    volume_factor: float  # the line length in 2D (a pressure integral to N), 1 in 3D
 
     def __call__(self, setup, step) -> Optional[str]:
         if step.cycle == 0:
@@ -315,8 +315,7 @@ def rule_for(case, setup, plan, accuracy: Optional[float] = None) -> Optional[Co
     if (accuracy is None or not grid_is_automatic(plan) or not line or setup.coarse is not None
             or refined or setup.fatigue_specs or case.loading.cycles == 0):
         return None
-    return CoarsenRule(accuracy, case.pressure_accuracy, case.loading.lightest_load / setup.volume_factor,
-                       setup.volume_factor)
+    return CoarsenRule(accuracy, case.pressure_accuracy, case.loading.lightest_load / setup.volume_factor)
 
 
 @dataclass(frozen=True)
