@@ -272,7 +272,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
     "grid": {
         "domain": Key("lengths", "[x, y] extents (one entry in 2D); automatic from the final scar if absent (and then widened "
                                    "during the run if the contact outgrows it)", None),
-        "elements": Key("counts", "[Mx, My] elements; automatic (7a/40) if absent", None, lo=1, hi=100_000),
+        "elements": Key("counts", "[Mx, My] elements; automatic (7a/40) if absent (and then coarsened along x as "
+                                  "the scar grows, in 2D and for a line contact)", None, lo=1, hi=100_000),
         "coarse_element": Key("lengths", "[dx, dy] of a coarse grid to solve the contact on (refinement, "
                                          "Eqs. 11–12)", None),
         "rule": Key("choice", "how the automatic grid is sized: accuracy (the element along x small enough for "
