@@ -10,6 +10,7 @@ run them twice.  A plan made without one prints nothing and keeps nothing.
 """
 from __future__ import annotations
 
+import contextlib
 from dataclasses import dataclass, field
 from typing import Any, Callable, Optional
 
@@ -34,9 +35,7 @@ class SideRuns:
     def run(self, what: str, setup):
         """simulate(setup) for one of the runs a run makes besides its own, announced and with progress."""
         self.say(what)
-        if self.progress is None:
-            return simulate(setup)
-        with self.progress(setup) as update:
+        with self._progress(setup) as update:
             return simulate(setup, progress=update)
 
     def run_following(self, what: str, setup, case, rule, prepare_fn):
@@ -44,11 +43,13 @@ class SideRuns:
         setup it ended on, the coarsenings)."""
         from fretsim.regrid import following
         self.say(what)
-        if self.progress is None:
-            return following(lambda s, st, r: simulate(s, resume=st, coarsen=r), setup, case, rule, prepare_fn)
-        with self.progress(setup) as update:
+        with self._progress(setup) as update:
             return following(lambda s, st, r: simulate(s, progress=update, resume=st, coarsen=r), setup, case,
                              rule, prepare_fn)
+
+    def _progress(self, setup):
+        """The owner's progress for ``setup`` (a context manager yielding a callback), or none."""
+        return self.progress(setup) if self.progress is not None else contextlib.nullcontext(None)
 
     def remembered(self, cache: dict, key: str, compute: Callable[[], Any]) -> Any:
         """``cache[key]``, computed once."""
