@@ -30,6 +30,7 @@ from fretsim.grid import Grid
 from fretsim.loading import Loading
 from fretsim.loop import blocks, checkpoint, checks, fatigue
 from fretsim.loop.landing import Landing, Reached
+from fretsim.loop.rows import NormalSolve
 from fretsim.quantities import wear_summary
 from fretsim.refine import coarsen, refine_pressure
 from fretsim.regrid import Coarsen
@@ -194,6 +195,7 @@ class _Loop:
         self._summed = (None, None, None)  # (extra, compliance, their sum) of the last implicit solve
         self.miners = fatigue.miners(setup)  # each body's fatigue damage so far (loop.fatigue)
         self.coarsen: Optional[Callable] = None  # asked after each step whether the grid may coarsen (regrid)
+        self.solves = NormalSolve(self)  # what the cycle members call: normal, one gap or a stack (loop.rows)
 
     def restore(self, st: dict) -> None:
         checkpoint.restore(self, st)
@@ -234,7 +236,7 @@ class _Loop:
         wear (h_m, h_s) + s·rates is the one its pressure belongs to.
         """
         try:
-            return self.model.solve(self.h_m if h_m is None else h_m, self.h_s if h_s is None else h_s, self.normal,
+            return self.model.solve(self.h_m if h_m is None else h_m, self.h_s if h_s is None else h_s, self.solves,
                                     guess, step=implicit, memory=self.memory, cycle=cycle,
                                     detail=detail or cycle in self.s.snapshots or (
                                         TRACTIONS if self._fatigue_due(cycle) else False))

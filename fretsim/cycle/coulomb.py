@@ -38,11 +38,13 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
+from typing import Optional
 
 import numpy as np
 
 from fretsim.compliance import scaled
 from fretsim.cycle.loop import LOOP_SIDE_INCREMENTS, elastic_side, loop_path, turning_loop
+from fretsim.cycle.resolved import TRAVEL_TOLERANCE, add_rows, mismatch_rows, positions, sweep_of
 from fretsim.cycle.result import TRACTIONS, Cycle, CycleError, CycleSpec, stick_half_width
 from fretsim.grid import Grid
 from fretsim.solvers.tangential import solve_tangential
@@ -66,8 +68,6 @@ RESOLVED_PASSES = 1 + RESOLVED_CORRECTIONS  # the cost estimate's passes per res
 FATIGUE_SIDE_INCREMENTS = 1  # each elastic side of a fatigue state's cycle (not recorded): the flat's stresses
 #                              over the side move between its ends (the damage with 1, 2 and 12 alike to 1e-11 at
 #                              4, 10 and 25 µm on cases/ti_fretting_fatigue.yaml)
-TRAVEL_TOLERANCE = 0.1  # of an element: a resolved increment is solved again where a point's predicted travel was off
-#                         by more (the pressure follows the worn flat on that scale)
 
 
 @dataclass(frozen=True)
@@ -165,7 +165,7 @@ class CoulombCycle:
         return cyc
 
     def _solve(self, wear_moving, wear_stationary, normal, guess, step: float = 0.0, memory=None,
-              cycle: int = 0, detail: bool = True, correction=None, corrected: bool = False) -> Cycle:
+              cycle: int = 0, detail: bool = True, correction=None, corrected: bool = False, predicted=None) -> Cycle:
         """One cycle.  With the pressure fixed (mid_stroke) a half-stroke is one monotone increment, which the
         tangential solve takes exactly whatever its length: unless ``detail`` asks for the loop's shape (a
         recorded state), each half-stroke is taken in one increment — the same wear, slips, energy and regime."""
@@ -187,10 +187,9 @@ class CoulombCycle:
             fine = FATIGUE_SIDE_INCREMENTS
         path = (loop_path(self.stroke, self._elastic_side(fixed[0]), fine) if detail and not self.resolved
                 and not self.rigid else increment_path(self.stroke, n))
-        first = next(k for k, step in enumerate(path) if step[2])  # the loop's first increment (after the quarter)
-        # the increment over U = 0 going up (centred on it for the resolved stroke's odd count); the up-stroke's end
-        mid = next(k for k in range(first, len(path)) if path[k][0] < 0.0 <= path[k][1])
-        end = max(k for k in range(first, len(path)) if path[k][1] > path[k][0])
+        first, mid, end = _marks(path)
+        pre = positions(self, wear_moving, wear_stationary, normal, np.array([b - a for a, b, _ in path]), guess,
+                        extra, cycle, correction, predicted) if self.resolved else None
         p_prev, ds_prev, du_prev = guess, None, None
         visits = []  # an implicit resolved step's (pressure, travel) at each increment, for its mismatch
         states = [] if detail else None  # the tractions round the loop (fretting fatigue; any pass may be returned)
@@ -201,18 +200,20 @@ class CoulombCycle:
                 if states is not None:
                     states.append((p_prev if p_prev is not None else fixed[0], q, s))
             du = u1 - u0
-            if self.resolved:
+            if pre is not None:
+                p, res, q_new, ds, stuck = pre[0][k:k + 1], pre[1][k], pre[2][k:k + 1], pre[4][k:k + 1], pre[5][k:k + 1]
+            elif self.resolved:
                 shift = correction[k] if correction is not None else None
                 p, res, q_new, ds, stuck = self._resolved_increment(wear_moving, wear_stationary, normal, q, s, du,
                                                                     p_prev, ds_prev, du_prev, extra, cycle, tally,
                                                                     shift)
-                if corrected:
-                    visits.append((p, s, s + ds))
+                visits.append((p, s, s + ds))
             else:
                 (p, res), (q_new, ds, stuck, its) = fixed, self._tangential(q, fixed[0], du)
                 tally.iterations += its
-            if counted:
+            if counted and pre is None:
                 tally.add(self, p, q_new, s, ds, abs(du) / (4.0 * self.stroke))
+            if counted:
                 tally.loop(u1, q_new)
                 if states is not None:
                     states.append((p, q_new, s + ds))
@@ -223,20 +224,23 @@ class CoulombCycle:
                 q_high, p_high = q_new, p
             s, q = s + ds, q_new
             p_prev, ds_prev, du_prev = p, ds, du
+        stacks = _stacked(self, tally, path, pre, wear_stationary) if self.resolved else None
         if self.resolved and detail is True and not self.rigid and not corrected:  # (a corrected pass draws no loop)
             tally.loop_u, tally.loop_q = turning_loop(self.stroke, fine, self._tangential, self._elastic_side,
                                                       (q_low, p_low), (q_high, p_high), tally.area)
         defect, mismatch = 0.0, None
         if step:
+            ahead = mismatch_rows(tally, stacks[3], stacks[0], step, w_lin) if stacks else None
             defect, mismatch = self._defect(wear_moving, wear_stationary, step, w_lin, tally, p_mid, travel_mid,
                                             correction[mid] if self.resolved and correction is not None else
-                                            correction)
+                                            correction, None if ahead is None else ahead[mid])
             if self.resolved and corrected:
-                mismatch = _mismatches(visits, tally, step, w_lin, self.grid.dx, self.kernel)
+                mismatch = ahead or _mismatches(visits, tally, step, w_lin, self.grid.dx, self.kernel)
         cyc = tally.cycle(self, p_mid, res_mid, stick_end, defect, mismatch)
         if states:
             cyc.tractions = tuple(np.array(a) for a in zip(*states))
         cyc.turns = ((q_low, p_low), (q_high, p_high)) if self.resolved else None
+        cyc.positions = stacks  # the resolved stroke's (pressures, starts, travels): the next pass's prediction
         return cyc
 
     def _resolved_increment(self, wear_moving, wear_stationary, normal, q, s, du, p_prev, ds_prev, du_prev, extra,
@@ -277,14 +281,16 @@ class CoulombCycle:
         return p, res, q_new, ds, stuck
 
     def _defect(self, wear_moving, wear_stationary, step: float, w_lin, tally: "_Tally", p_mid, travel_mid,
-                correction) -> tuple[float, np.ndarray]:
+                correction, mismatch=None) -> tuple[float, np.ndarray]:
         """An implicit step's linearisation error: the gap growth the mid-stroke solve anticipated against what the
-        cycle found for that position (``mismatch``), and its effect on the deepest element's wear (``defect``)."""
+        cycle found for that position (``mismatch``, unless given), and its effect on the deepest element's wear
+        (``defect``)."""
         dx, shape = self.grid.dx, self.grid.shape
-        found = tally.rate_m + (sweep_read(tally.rate_s, *travel_mid, dx, self.kernel) if self.resolved else
-                                gap_wear(np.zeros(shape), tally.rate_s, dx, self.stroke, self.gap_model))
+        if mismatch is None:
+            found = tally.rate_m + (sweep_read(tally.rate_s, *travel_mid, dx, self.kernel) if self.resolved else
+                                    gap_wear(np.zeros(shape), tally.rate_s, dx, self.stroke, self.gap_model))
+            mismatch = step * (found - w_lin(p_mid))
         deepest = np.unravel_index(np.argmax(wear_moving + wear_stationary), shape)
-        mismatch = step * (found - w_lin(p_mid))
         defect = abs(float(_response(self.compliance, step, w_lin, mismatch - (correction if correction is not None else 0))
                            [deepest]))
         return defect, mismatch
@@ -365,6 +371,15 @@ class _Tally:
             defect=defect, mismatch=mismatch, stick=stick_end if stick_end.any() else None)
 
 
+def _marks(path: list) -> tuple[int, int, int]:
+    """The loop's first increment (after the quarter); the increment over U = 0 going up (centred on it for the
+    resolved stroke's odd count); the up-stroke's end."""
+    first = next(k for k, step in enumerate(path) if step[2])
+    mid = next(k for k in range(first, len(path)) if path[k][0] < 0.0 <= path[k][1])
+    end = max(k for k in range(first, len(path)) if path[k][1] > path[k][0])
+    return first, mid, end
+
+
 def increment_path(stroke: float, n: int) -> list[tuple[float, float, bool]]:
     """(U at the start, U at the end, counted) of every increment: 0 → −δ in one (uncounted: it sets up the
     traction's history, and loading monotonically from rest it is exact at a fixed pressure; cut as the loop it
@@ -399,7 +414,8 @@ def _resolved_step(member: CoulombCycle, wear_moving, wear_stationary, normal, g
     cyc, correction = None, None
     for _ in range(1 + RESOLVED_CORRECTIONS):
         cyc = member._solve(wear_moving, wear_stationary, normal, guess if cyc is None else cyc.pressure, step,
-                            memory, cycle, detail, correction=correction, corrected=True)
+                            memory, cycle, detail, correction=correction, corrected=True,
+                            predicted=None if cyc is None else cyc.positions)
         correction = cyc.mismatch
     if detail is True and not member.rigid:  # the recorded loop, of the pass returned only (48 ms a 2D draw)
         u, q = turning_loop(member.stroke, max(LOOP_SIDE_INCREMENTS, member.increments), member._tangential,
@@ -412,6 +428,20 @@ def _mismatches(visits: list, tally: _Tally, step: float, w_lin, dx: float, kern
     """For a resolved step's next pass, each increment's own mismatch: the gap growth its position found against
     the anticipated."""
     return [step * (tally.rate_m + sweep_read(tally.rate_s, a, b, dx, kernel) - w_lin(pk)) for pk, a, b in visits]
+
+
+def _stacked(member: CoulombCycle, tally: _Tally, path: list, pre, wear_stationary) -> Optional[tuple]:
+    """A resolved cycle's (pressures, starts, travels, their Sweep) at every increment, stacks (m, nx), where its
+    increments were solved together (``pre``; the tally then adds the counted ones at once); None where one by
+    one."""
+    if pre is None:
+        return None
+    p, _, q, s, ds, _, iterations = pre
+    shares = np.array([abs(b - a) if c else 0.0 for a, b, c in path]) / (4.0 * member.stroke)
+    sweep = sweep_of(member, p, s, ds, wear_stationary)
+    add_rows(tally, member, sweep, p, q, ds, shares)
+    tally.iterations += iterations
+    return p, s, ds, sweep
 
 
 def _nearest_in_contact(values: np.ndarray, on: np.ndarray) -> np.ndarray:

@@ -47,6 +47,7 @@ class Cycle:
     # point's travel over the flat (mm) at the loop's start and the end of each increment, arrays (state, ny, nx)
     tractions: Optional[tuple] = None
     turns: Optional[tuple] = None  # the resolved stroke: (traction, pressure) at −δ and +δ, the recorded loop's start
+    positions: Optional[tuple] = None  # the resolved stroke solved as a stack: (pressures, starts, travels) (m, nx)
     bias: float = 0.0  # implicit steps: what the step's corrections, stopped early, may leave there (mm): counted in
     #                    the error estimate, not in the step's control (the corrections' own tolerance holds it)
 

@@ -1,0 +1,158 @@
+"""Many normal contacts on one 2D grid at once: the resolved stroke's positions, solved together.
+
+A resolved fretting cycle solves the same contact at a score of positions along the stroke.  On a 2D grid each
+solve is a few hundred elements, where numpy's cost per call, not the arithmetic, is the time; stacked as the
+rows of one array (a 2D convolution applies to every row of a stack alike), all the positions cost about what
+two or three solves did.  :func:`solve_rows` is :func:`fretsim.solvers.cg.solve_cg` row by row: the same
+Polonsky–Keer iteration, preconditioner, stopping rule and result; each row stops when it converges.  On the
+union of the warm starts' windows, then verified on the whole grid as :func:`fretsim.solvers.solve` does; a
+row whose contact outgrew the window, or that did not converge, is solved again alone by the caller's own
+solve (which has the fallbacks).
+"""
+from __future__ import annotations
+
+import numpy as np
+
+from fretsim.solvers import WINDOW_MARGIN, PENETRATION as WINDOW_PENETRATION
+from fretsim.solvers.cg import PENETRATION, RECOMPUTE_EVERY, _admit, _preconditioner
+from fretsim.solvers.result import ContactResult
+
+
+def solve_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float) -> list:
+    """The contacts of the rows of ``gaps`` (m, nx) on the 2D grid of ``op`` (a convolution), warm-started from
+    ``p0`` (m, nx), each carrying ``load``: a ContactResult per row (pressure (1, nx)), or None where the row
+    must be solved alone (it did not converge on the window, or its contact outgrew it)."""
+    nx = gaps.shape[1]
+    on = (p0 > 0).any(axis=0)
+    idx = np.flatnonzero(on)
+    if not idx.size:
+        return [None] * gaps.shape[0]
+    margin = max(WINDOW_MARGIN[0], int(WINDOW_MARGIN[1] * (idx[-1] - idx[0] + 1)))
+    cols = slice(max(0, idx[0] - margin), min(nx, idx[-1] + margin + 1))
+    win = op.window(slice(0, 1), cols) if cols.stop - cols.start < nx else op
+    found = cg_rows(win, gaps[:, cols], load, p0[:, cols], tol)
+    p = np.zeros(gaps.shape)
+    p[:, cols] = found[0]
+    u = op(p)  # the whole grid: nothing outside the window may penetrate
+    approach, ok, its, err = found[1:]
+    finite = np.isfinite(gaps)
+    y = np.where(finite, u + gaps - approach[:, None], np.inf)
+    on = p > 0
+    scale = np.maximum(np.where(on, np.abs(u), 0.0).max(axis=1), 1e-300)
+    inside = np.zeros(nx, bool)
+    inside[cols] = True
+    ok = ok & ~(~inside & (y < -WINDOW_PENETRATION * scale[:, None])).any(axis=1)
+    # complementarity_residual, row by row: max(|Y| in contact, −Y outside) over the spread of u
+    worst = np.maximum(np.where(on, np.abs(y), 0.0).max(axis=1),
+                       np.where(~on & finite, np.clip(-y, 0.0, None), 0.0).max(axis=1))
+    spread = u.max(axis=1) - u.min(axis=1)
+    residual = worst / np.where(spread > 0, spread, 1.0)
+    note = f"solved with {gaps.shape[0] - 1} other positions"
+    return [ContactResult(p[k][None, :], float(approach[k]), on[k][None, :], int(its[k]), True,
+                          f"cg converged in {its[k]} iterations (relative pressure change {err[k]:.1e} < {tol:.0e}, "
+                          f"gap complementary; {note})", float(residual[k])) if ok[k] else None
+            for k in range(gaps.shape[0])]
+
+
+def cg_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float):
+    """Preconditioned constrained CG on every row: (pressures (m, n), approaches, converged, iterations, last
+    relative changes).  Each row follows :func:`fretsim.solvers.cg.solve_cg`'s iteration; a converged row is
+    set aside and the others go on."""
+    m, n = gaps.shape
+    total = load / op.grid.area
+    allowed = np.isfinite(gaps)
+    h = np.where(allowed, gaps, 0.0)
+    max_iter = max(1000, 5 * int(np.sqrt(n)) + 200)
+    precond = _preconditioner(op)
+    p = np.where(allowed, np.clip(p0, 0.0, None), 0.0)
+    empty = ~(p > 0).any(axis=1)
+    if empty.any():  # (a warm start without contact on the window: start near the closest points, as solve_cg)
+        for k in np.flatnonzero(empty):
+            hk = h[k][allowed[k]]
+            p[k] = allowed[k] & (h[k] <= hk.min() + 0.5 * (np.percentile(hk, 10) - hk.min()) + 1e-300)
+    p *= (total / p.sum(axis=1))[:, None]
+    pressures, approach = np.zeros((m, n)), np.zeros(m)
+    ok, iterations, errors = np.zeros(m, bool), np.zeros(m, int), np.full(m, np.inf)
+    live = np.arange(m)
+    h_all, hl, al = h, h, allowed  # the live rows' gaps and masks
+    u = op(p)
+    t = np.zeros_like(p)
+    gz_old, delta, err = np.ones(m), np.zeros(m), np.full(m, np.inf)
+    for it in range(1, max_iter + 1):
+        mask = p > 0
+        w = mask.astype(float)
+        count = w.sum(axis=1)
+        g = u + hl
+        g -= ((g * w).sum(axis=1) / count)[:, None]
+        z = precond(g * w) * w
+        z -= w * (z.sum(axis=1) / count)[:, None]
+        gz = (g * z).sum(axis=1)
+        beta = np.where(delta > 0, delta * gz / gz_old, 0.0)
+        t = (z + beta[:, None] * t) * w
+        gz_old = gz
+        r_raw = op(t)
+        denom = (r_raw * t).sum(axis=1) - (r_raw * w).sum(axis=1) / count * t.sum(axis=1)
+        penetrating = ~mask & al & (g < 0.0)
+        pen = penetrating.any(axis=1)
+        still = (denom <= 0.0) | (gz == 0.0)
+        done = still & ~pen  # nothing left to do on the set, and nothing outside it penetrates
+        err = np.where(done, 0.0, err)
+        p_old = p
+        tau = np.where(still, 0.0, (g * t).sum(axis=1) / np.where(still, 1.0, denom))
+        p, clipped, scale = _steps(p_old, tau, t, g, penetrating, total)
+        for k in np.flatnonzero(still & pen):  # put pressure on the penetrating elements (rare)
+            p[k] = _admit(p_old[k], g[k], penetrating[k], total)
+        delta = np.where(pen, 0.0, 1.0)
+        recompute = clipped | pen | still | (it % RECOMPUTE_EVERY == 0)
+        u = scale[:, None] * (u - tau[:, None] * r_raw)
+        if recompute.any():
+            u[recompute] = op(p[recompute])
+        err = np.where(still, err, np.abs(p - p_old).sum(axis=1) / total)
+        bad = ~np.isfinite(err)
+        fin = done | bad | ((err < tol) & _complementary_rows(u, hl, p, al) & ~still)
+        if fin.any() or it == max_iter:
+            if it == max_iter:
+                fin = np.ones(live.size, bool)
+            rows = live[fin]
+            pressures[rows] = np.where(bad[fin, None], p_old[fin], p[fin])
+            ok[rows] = ~bad[fin] & (err[fin] < tol) & (done[fin] | _complementary_rows(u[fin], hl[fin], p[fin],
+                                                                                        al[fin]))
+            iterations[rows], errors[rows] = it, err[fin]
+            keep = ~fin
+            live, p, u, t, gz_old, delta, err = live[keep], p[keep], u[keep], t[keep], gz_old[keep], delta[keep], err[keep]
+            hl, al = hl[keep], al[keep]
+            if not live.size:
+                break
+    u_all = op(pressures)
+    on = pressures > 0
+    approach = np.where(on.any(axis=1), ((u_all + h_all) * on).sum(axis=1) / np.maximum(on.sum(axis=1), 1), 0.0)
+    return pressures, approach, ok, iterations, errors
+
+
+def _steps(p_old, tau, t, g, penetrating, total):
+    """Each row's step p − τt clipped to p ≥ 0, penetrating elements added, rescaled to the load (cg._step, row
+    by row: a step that lifted a row off entirely is halved for that row)."""
+    tau = tau.copy()
+    for _ in range(60):
+        trial = p_old - tau[:, None] * t
+        clipped = (trial < 0.0).any(axis=1)
+        p = np.clip(trial, 0.0, None)
+        p = np.where(penetrating, p - tau[:, None] * g, p)
+        sums = p.sum(axis=1)
+        lifted = sums <= 0.0
+        if not lifted.any():
+            break
+        tau = np.where(lifted, 0.5 * tau, tau)
+    scale = total / p.sum(axis=1)
+    return p * scale[:, None], clipped, scale
+
+
+def _complementary_rows(u, h, p, allowed) -> np.ndarray:
+    """cg._complementary, row by row: nothing outside the contact set penetrates beyond PENETRATION."""
+    on = p > 0
+    g = u + h
+    alpha = (g * on).sum(axis=1) / np.maximum(on.sum(axis=1), 1)
+    outside = ~on & allowed
+    scale = np.maximum(np.where(on, np.abs(u), 0.0).max(axis=1), 1e-300)
+    worst = np.where(outside, g - alpha[:, None], np.inf).min(axis=1)
+    return worst >= -PENETRATION * scale
