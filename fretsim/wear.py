@@ -140,9 +140,16 @@ def wear_operator(grid: Grid, stroke: float, k_moving: float, k_stationary: floa
 # --- the flat under a moving body whose points travel differently (the resolved cycle) -----------------------------
 
 def _hat_integral(t: np.ndarray) -> np.ndarray:
-    """∫_{−∞}^{t} of the unit hat (1 − |u|)⁺: 0, (t + 1)²/2, 1 − (1 − t)²/2, 1."""
+    """∫_{−∞}^{t} of the unit hat (1 − |u|)⁺: 0, (t + 1)²/2, 1 − (1 − t)²/2, 1 — on [−1, 1] both pieces are
+    ½ + t(1 − |t|/2), which takes a third of the passes over the array (a resolved cycle's sweeps are its largest
+    arrays)."""
     t = np.clip(t, -1.0, 1.0)
-    return np.where(t < 0, 0.5 * (t + 1.0) ** 2, 1.0 - 0.5 * (1.0 - t) ** 2)
+    out = np.abs(t)
+    out *= -0.5
+    out += 1.0
+    out *= t
+    out += 0.5
+    return out
 
 
 def _sweep_shares(start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box", nx: int = 0, c0: int = 0):
@@ -175,8 +182,11 @@ def _sweep_shares(start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "
         first = np.floor(lo).astype(int)  # the hats that can be non-zero over [lo, hi]: first .. ceil(hi)
         span = max(int(np.max(np.ceil(hi) - first)) + 1 if start.size else 2, 2)
         cell = first[None] + np.arange(span)[:, None, None]
-        share = np.where(point, np.clip(1.0 - np.abs(lo - cell), 0.0, None),
-                         (_hat_integral(hi - cell) - _hat_integral(lo - cell)) / np.where(point, 1.0, length))
+        share = _hat_integral(hi - cell)
+        share -= _hat_integral(lo - cell)
+        share /= np.where(point, 1.0, length)
+        if point.any():  # (in gross slip no point stays put: the branch is skipped)
+            share = np.where(point, np.clip(1.0 - np.abs(lo - cell), 0.0, None), share)
     target = cols + cell
     return target, share, (target >= 0) & (target < nx) & (share > 0)
 

@@ -44,8 +44,8 @@ def next_fast_len(n: int, real: bool) -> int:
 def _public_forward(p: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
     import scipy.fft as sfft
     ly, lx = shape
-    ph = sfft.rfft(p, n=lx, axis=1, workers=1)
-    return sfft.fft(ph, n=ly, axis=0, workers=1) if ly > 1 else ph
+    ph = sfft.rfft(p, n=lx, axis=-1, workers=1)
+    return sfft.fft(ph, n=ly, axis=-2, workers=1) if ly > 1 else ph
 
 
 def _public_backward(ph: np.ndarray, shape: tuple[int, int], out_shape: tuple[int, int]) -> np.ndarray:
@@ -53,8 +53,8 @@ def _public_backward(ph: np.ndarray, shape: tuple[int, int], out_shape: tuple[in
     ny, nx = out_shape
     ly, lx = shape
     if ly > 1:
-        ph = sfft.ifft(ph, axis=0, workers=1)[:ny]
-    return sfft.irfft(ph, n=lx, axis=1, workers=1)[:, :nx]
+        ph = sfft.ifft(ph, axis=-2, workers=1)[..., :ny, :]
+    return sfft.irfft(ph, n=lx, axis=-1, workers=1)[..., :nx]
 
 
 def _direct():
@@ -62,29 +62,30 @@ def _direct():
 
     def forward(p: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
         ly, lx = shape
-        ny, nx = p.shape
-        buf = np.zeros((ny, lx))
-        buf[:, :nx] = p
-        ph = pp.r2c(buf, (1,), True, 0, None, 1)
+        *lead, ny, nx = p.shape
+        buf = np.zeros((*lead, ny, lx))
+        buf[..., :nx] = p
+        ph = pp.r2c(buf, (buf.ndim - 1,), True, 0, None, 1)
         if ly > 1:  # the padding rows are zero: x first on the My rows, then y on the padded length
-            full = np.zeros((ly, ph.shape[1]), dtype=complex)
-            full[:ny] = ph
-            ph = pp.c2c(full, (0,), True, 0, full, 1)
+            full = np.zeros((*lead, ly, ph.shape[-1]), dtype=complex)
+            full[..., :ny, :] = ph
+            ph = pp.c2c(full, (full.ndim - 2,), True, 0, full, 1)
         return ph
 
     def backward(ph: np.ndarray, shape: tuple[int, int], out_shape: tuple[int, int]) -> np.ndarray:
         ny, nx = out_shape
         ly, lx = shape
         if ly > 1:
-            ph = pp.c2c(ph, (0,), False, 2, None, 1)[:ny]
-        return pp.c2r(ph, (1,), lx, False, 2, None, 1)[:, :nx]
+            ph = pp.c2c(ph, (ph.ndim - 2,), False, 2, None, 1)[..., :ny, :]
+        return pp.c2r(ph, (ph.ndim - 1,), lx, False, 2, None, 1)[..., :nx]
 
     rng = np.random.default_rng(0)
-    for shape, p in (((10, 16), rng.random((4, 7))), ((1, 12), rng.random((1, 5)))):
+    for shape, p in (((10, 16), rng.random((4, 7))), ((1, 12), rng.random((1, 5))), ((10, 16), rng.random((3, 4, 7)))):
         a, b = forward(p, shape), _public_forward(p, shape)
         if a.shape != b.shape or not np.allclose(a, b, rtol=1e-12, atol=1e-12):
             raise RuntimeError("pocketfft binding disagrees")
-        if not np.allclose(backward(a, shape, p.shape), _public_backward(b, shape, p.shape), rtol=1e-12, atol=1e-12):
+        if not np.allclose(backward(a, shape, p.shape[-2:]), _public_backward(b, shape, p.shape[-2:]), rtol=1e-12,
+                           atol=1e-12):
             raise RuntimeError("pocketfft binding disagrees")
     return forward, backward
 
@@ -101,7 +102,8 @@ def _choose() -> tuple:
 
 
 def forward(p: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
-    """p (My, Mx) zero-padded to ``shape`` and transformed: rfft along x, then fft along y."""
+    """p (My, Mx) zero-padded to ``shape`` and transformed: rfft along x, then fft along y.  A stack (…, My, Mx)
+    is transformed layer by layer in one call (the resolved stroke's positions)."""
     return _choose()[0](p, shape)  # the first call replaces this module's forward and backward
 
 

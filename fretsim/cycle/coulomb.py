@@ -201,7 +201,7 @@ class CoulombCycle:
                     states.append((p_prev if p_prev is not None else fixed[0], q, s))
             du = u1 - u0
             if pre is not None:
-                p, res, q_new, ds, stuck = pre[0][k:k + 1], pre[1][k], pre[2][k:k + 1], pre[4][k:k + 1], pre[5][k:k + 1]
+                p, res, q_new, ds, stuck = pre[0][k], pre[1][k], pre[2][k], pre[4][k], pre[5][k]
             elif self.resolved:
                 shift = correction[k] if correction is not None else None
                 p, res, q_new, ds, stuck = self._resolved_increment(wear_moving, wear_stationary, normal, q, s, du,
@@ -230,7 +230,7 @@ class CoulombCycle:
                                                       (q_low, p_low), (q_high, p_high), tally.area)
         defect, mismatch = 0.0, None
         if step:
-            ahead = mismatch_rows(tally, stacks[3], stacks[0], step, w_lin) if stacks else None
+            ahead = mismatch_rows(tally, self, stacks[3], *stacks[:3], step, w_lin) if stacks else None
             defect, mismatch = self._defect(wear_moving, wear_stationary, step, w_lin, tally, p_mid, travel_mid,
                                             correction[mid] if self.resolved and correction is not None else
                                             correction, None if ahead is None else ahead[mid])
@@ -430,15 +430,15 @@ def _mismatches(visits: list, tally: _Tally, step: float, w_lin, dx: float, kern
     return [step * (tally.rate_m + sweep_read(tally.rate_s, a, b, dx, kernel) - w_lin(pk)) for pk, a, b in visits]
 
 
-def _stacked(member: CoulombCycle, tally: _Tally, path: list, pre, wear_stationary) -> Optional[tuple]:
-    """A resolved cycle's (pressures, starts, travels, their Sweep) at every increment, stacks (m, nx), where its
-    increments were solved together (``pre``; the tally then adds the counted ones at once); None where one by
-    one."""
+def _stacked(member: CoulombCycle, tally: _Tally, path: list, pre, wear_stationary) -> tuple:
+    """A resolved cycle's (pressures, starts, travels, their Sweep) at every increment, stacks (m, My, Mx), where its
+    increments were solved together (``pre``; the tally then adds the counted ones at once); () where one by one
+    (the step's next passes then go one by one too)."""
     if pre is None:
-        return None
+        return ()
     p, _, q, s, ds, _, iterations = pre
-    shares = np.array([abs(b - a) if c else 0.0 for a, b, c in path]) / (4.0 * member.stroke)
-    sweep = sweep_of(member, p, s, ds, wear_stationary)
+    shares = np.array([abs(b - a) for a, b, _ in path]) / (4.0 * member.stroke)
+    sweep = sweep_of(member, p, s, ds, wear_stationary, np.array([c for _, _, c in path]))
     add_rows(tally, member, sweep, p, q, ds, shares)
     tally.iterations += iterations
     return p, s, ds, sweep

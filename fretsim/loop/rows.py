@@ -2,8 +2,8 @@
 
 A resolved fretting cycle solves the contact at every position of the stroke; on a 2D grid the positions are
 solved together (:func:`fretsim.solvers.rows.solve_rows`), each checked as the loop checks one solve.  Where
-they cannot be (refinement's coarse grid, an operator that is not a convolution, a solver other than cg, a 3D
-grid), :meth:`NormalSolve.rows` says so (None) and the member solves them one by one.
+they cannot be (refinement's coarse grid, an operator that is not a convolution, a solver other than cg),
+:meth:`NormalSolve.rows` says so (None) and the member solves them one by one.
 """
 from __future__ import annotations
 
@@ -29,12 +29,12 @@ class NormalSolve:
         return self.loop.normal(seen, guess, extra, load=load, cycle=cycle)
 
     def rows(self, seen: np.ndarray, guess: np.ndarray, extra=None, load: Optional[float] = None, cycle: int = 0):
-        """(pressures (m, nx), a ContactResult per row) for the gaps ε + ``seen`` (m, nx) on a 2D grid, warm-started
-        from ``guess`` (m, nx); None where they cannot be solved together.  A row the stack did not settle is
+        """(pressures (m, My, Mx), a ContactResult per layer) for the gaps ε + ``seen`` (m, My, Mx), warm-started
+        from ``guess`` (m, My, Mx); None where they cannot be solved together.  A row the stack did not settle is
         solved alone, with the single solve's fallbacks and checks; every row is checked as a single solve is."""
         loop = self.loop
         s = loop.s
-        if s.coarse is not None or s.method != "cg" or s.grid.shape[0] != 1:
+        if s.coarse is not None or s.method != "cg":
             return None
         op = s.compliance
         if extra is not None:
@@ -47,11 +47,11 @@ class NormalSolve:
         pressures, results = np.zeros(seen.shape), []
         for k, res in enumerate(found):
             if res is None:
-                p, res = loop.normal(seen[k:k + 1], guess[k:k + 1], extra, load=load, cycle=cycle)
+                p, res = loop.normal(seen[k], guess[k], extra, load=load, cycle=cycle)
             else:
                 checks.check_solution(res, op.grid.area, load, s.method, cycle, loop.n)
                 p = res.pressure
-            pressures[k] = p[0]
+            pressures[k] = p
             results.append(res)
-        checks.check_edges(pressures, s.band, s.grid, cycle, s.y_edges_free)  # (2D: every row's columns at once)
+        checks.check_edges(pressures.max(axis=0), s.band, s.grid, cycle, s.y_edges_free)  # every layer's at once
         return pressures, results

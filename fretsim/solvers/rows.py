@@ -17,61 +17,69 @@ from fretsim.solvers import WINDOW_MARGIN, PENETRATION as WINDOW_PENETRATION
 from fretsim.solvers.cg import PENETRATION, RECOMPUTE_EVERY, _admit, _preconditioner
 from fretsim.solvers.result import ContactResult
 
+A = (1, 2)  # a stack's layer axes (My, Mx): each layer's sums, maxima and tests
+
 
 def solve_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float) -> list:
-    """The contacts of the rows of ``gaps`` (m, nx) on the 2D grid of ``op`` (a convolution), warm-started from
-    ``p0`` (m, nx), each carrying ``load``: a ContactResult per row (pressure (1, nx)), or None where the row
-    must be solved alone (it did not converge on the window, or its contact outgrew it)."""
-    nx = gaps.shape[1]
-    on = (p0 > 0).any(axis=0)
-    idx = np.flatnonzero(on)
-    if not idx.size:
-        return [None] * gaps.shape[0]
-    margin = max(WINDOW_MARGIN[0], int(WINDOW_MARGIN[1] * (idx[-1] - idx[0] + 1)))
-    cols = slice(max(0, idx[0] - margin), min(nx, idx[-1] + margin + 1))
-    win = op.window(slice(0, 1), cols) if cols.stop - cols.start < nx else op
-    found = cg_rows(win, gaps[:, cols], load, p0[:, cols], tol)
+    """The contacts of the layers of ``gaps`` (m, My, Mx) on the grid of ``op`` (a convolution), warm-started from
+    ``p0`` (m, My, Mx), each carrying ``load``: a ContactResult per layer, or None where the layer must be solved
+    alone (it did not converge on the window, or its contact outgrew it)."""
+    m, ny, nx = gaps.shape
+    on = p0 > 0
+    if not on.any():
+        return [None] * m
+    rows, cols = _span(on.any(axis=(0, 2)), ny), _span(on.any(axis=(0, 1)), nx)
+    whole = rows.stop - rows.start == ny and cols.stop - cols.start == nx
+    win = op if whole else op.window(rows, cols)
+    found = cg_rows(win, gaps[:, rows, cols], load, p0[:, rows, cols], tol)
     p = np.zeros(gaps.shape)
-    p[:, cols] = found[0]
+    p[:, rows, cols] = found[0]
     u = op(p)  # the whole grid: nothing outside the window may penetrate
     approach, ok, its, err = found[1:]
     finite = np.isfinite(gaps)
-    y = np.where(finite, u + gaps - approach[:, None], np.inf)
+    y = np.where(finite, u + gaps - approach[:, None, None], np.inf)
     on = p > 0
-    scale = np.maximum(np.where(on, np.abs(u), 0.0).max(axis=1), 1e-300)
-    inside = np.zeros(nx, bool)
-    inside[cols] = True
-    ok = ok & ~(~inside & (y < -WINDOW_PENETRATION * scale[:, None])).any(axis=1)
-    # complementarity_residual, row by row: max(|Y| in contact, −Y outside) over the spread of u
-    worst = np.maximum(np.where(on, np.abs(y), 0.0).max(axis=1),
-                       np.where(~on & finite, np.clip(-y, 0.0, None), 0.0).max(axis=1))
-    spread = u.max(axis=1) - u.min(axis=1)
+    scale = np.maximum(np.where(on, np.abs(u), 0.0).max(axis=(1, 2)), 1e-300)
+    inside = np.zeros((ny, nx), bool)
+    inside[rows, cols] = True
+    ok = ok & ~(~inside & (y < -WINDOW_PENETRATION * scale[:, None, None])).any(axis=(1, 2))
+    # complementarity_residual, layer by layer: max(|Y| in contact, −Y outside) over the spread of u
+    worst = np.maximum(np.where(on, np.abs(y), 0.0).max(axis=(1, 2)),
+                       np.where(~on & finite, np.clip(-y, 0.0, None), 0.0).max(axis=(1, 2)))
+    spread = u.max(axis=(1, 2)) - u.min(axis=(1, 2))
     residual = worst / np.where(spread > 0, spread, 1.0)
-    note = f"solved with {gaps.shape[0] - 1} other positions"
-    return [ContactResult(p[k][None, :], float(approach[k]), on[k][None, :], int(its[k]), True,
+    note = f"solved with {m - 1} other positions"
+    return [ContactResult(p[k], float(approach[k]), on[k], int(its[k]), True,
                           f"cg converged in {its[k]} iterations (relative pressure change {err[k]:.1e} < {tol:.0e}, "
                           f"gap complementary; {note})", float(residual[k])) if ok[k] else None
-            for k in range(gaps.shape[0])]
+            for k in range(m)]
+
+
+def _span(mask: np.ndarray, n: int) -> slice:
+    """The warm starts' extent along one axis and the single solve's margin round it (solvers.WINDOW_MARGIN)."""
+    idx = np.flatnonzero(mask)
+    margin = max(WINDOW_MARGIN[0], int(WINDOW_MARGIN[1] * (idx[-1] - idx[0] + 1)))
+    return slice(max(0, idx[0] - margin), min(n, idx[-1] + margin + 1))
 
 
 def cg_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float):
-    """Preconditioned constrained CG on every row: (pressures (m, n), approaches, converged, iterations, last
-    relative changes).  Each row follows :func:`fretsim.solvers.cg.solve_cg`'s iteration; a converged row is
+    """Preconditioned constrained CG on every layer of the stack (m, My, Mx): (pressures, approaches, converged,
+    iterations, last relative changes).  Each row follows :func:`fretsim.solvers.cg.solve_cg`'s iteration; a converged row is
     set aside and the others go on."""
-    m, n = gaps.shape
+    m, n = gaps.shape[0], gaps[0].size
     total = load / op.grid.area
     allowed = np.isfinite(gaps)
     h = np.where(allowed, gaps, 0.0)
     max_iter = max(1000, 5 * int(np.sqrt(n)) + 200)
     precond = _preconditioner(op)
     p = np.where(allowed, np.clip(p0, 0.0, None), 0.0)
-    empty = ~(p > 0).any(axis=1)
+    empty = ~(p > 0).any(axis=A)
     if empty.any():  # (a warm start without contact on the window: start near the closest points, as solve_cg)
         for k in np.flatnonzero(empty):
             hk = h[k][allowed[k]]
             p[k] = allowed[k] & (h[k] <= hk.min() + 0.5 * (np.percentile(hk, 10) - hk.min()) + 1e-300)
-    p *= (total / p.sum(axis=1))[:, None]
-    pressures, approach = np.zeros((m, n)), np.zeros(m)
+    p *= (total / p.sum(axis=A))[:, None, None]
+    pressures, approach = np.zeros(gaps.shape), np.zeros(m)
     ok, iterations, errors = np.zeros(m, bool), np.zeros(m, int), np.full(m, np.inf)
     live = np.arange(m)
     h_all, hl, al = h, h, allowed  # the live rows' gaps and masks
@@ -81,40 +89,40 @@ def cg_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float):
     for it in range(1, max_iter + 1):
         mask = p > 0
         w = mask.astype(float)
-        count = w.sum(axis=1)
+        count = w.sum(axis=A)
         g = u + hl
-        g -= ((g * w).sum(axis=1) / count)[:, None]
+        g -= ((g * w).sum(axis=A) / count)[:, None, None]
         z = precond(g * w) * w
-        z -= w * (z.sum(axis=1) / count)[:, None]
-        gz = (g * z).sum(axis=1)
+        z -= w * (z.sum(axis=A) / count)[:, None, None]
+        gz = (g * z).sum(axis=A)
         beta = np.where(delta > 0, delta * gz / gz_old, 0.0)
-        t = (z + beta[:, None] * t) * w
+        t = (z + beta[:, None, None] * t) * w
         gz_old = gz
         r_raw = op(t)
-        denom = (r_raw * t).sum(axis=1) - (r_raw * w).sum(axis=1) / count * t.sum(axis=1)
+        denom = (r_raw * t).sum(axis=A) - (r_raw * w).sum(axis=A) / count * t.sum(axis=A)
         penetrating = ~mask & al & (g < 0.0)
-        pen = penetrating.any(axis=1)
+        pen = penetrating.any(axis=A)
         still = (denom <= 0.0) | (gz == 0.0)
         done = still & ~pen  # nothing left to do on the set, and nothing outside it penetrates
         err = np.where(done, 0.0, err)
         p_old = p
-        tau = np.where(still, 0.0, (g * t).sum(axis=1) / np.where(still, 1.0, denom))
+        tau = np.where(still, 0.0, (g * t).sum(axis=A) / np.where(still, 1.0, denom))
         p, clipped, scale = _steps(p_old, tau, t, g, penetrating, total)
         for k in np.flatnonzero(still & pen):  # put pressure on the penetrating elements (rare)
             p[k] = _admit(p_old[k], g[k], penetrating[k], total)
         delta = np.where(pen, 0.0, 1.0)
         recompute = clipped | pen | still | (it % RECOMPUTE_EVERY == 0)
-        u = scale[:, None] * (u - tau[:, None] * r_raw)
+        u = scale[:, None, None] * (u - tau[:, None, None] * r_raw)
         if recompute.any():
             u[recompute] = op(p[recompute])
-        err = np.where(still, err, np.abs(p - p_old).sum(axis=1) / total)
+        err = np.where(still, err, np.abs(p - p_old).sum(axis=A) / total)
         bad = ~np.isfinite(err)
         fin = done | bad | ((err < tol) & _complementary_rows(u, hl, p, al) & ~still)
         if fin.any() or it == max_iter:
             if it == max_iter:
                 fin = np.ones(live.size, bool)
             rows = live[fin]
-            pressures[rows] = np.where(bad[fin, None], p_old[fin], p[fin])
+            pressures[rows] = np.where(bad[fin, None, None], p_old[fin], p[fin])
             ok[rows] = ~bad[fin] & (err[fin] < tol) & (done[fin] | _complementary_rows(u[fin], hl[fin], p[fin],
                                                                                         al[fin]))
             iterations[rows], errors[rows] = it, err[fin]
@@ -125,7 +133,7 @@ def cg_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float):
                 break
     u_all = op(pressures)
     on = pressures > 0
-    approach = np.where(on.any(axis=1), ((u_all + h_all) * on).sum(axis=1) / np.maximum(on.sum(axis=1), 1), 0.0)
+    approach = np.where(on.any(axis=A), ((u_all + h_all) * on).sum(axis=A) / np.maximum(on.sum(axis=A), 1), 0.0)
     return pressures, approach, ok, iterations, errors
 
 
@@ -134,25 +142,25 @@ def _steps(p_old, tau, t, g, penetrating, total):
     by row: a step that lifted a row off entirely is halved for that row)."""
     tau = tau.copy()
     for _ in range(60):
-        trial = p_old - tau[:, None] * t
-        clipped = (trial < 0.0).any(axis=1)
+        trial = p_old - tau[:, None, None] * t
+        clipped = (trial < 0.0).any(axis=A)
         p = np.clip(trial, 0.0, None)
-        p = np.where(penetrating, p - tau[:, None] * g, p)
-        sums = p.sum(axis=1)
+        p = np.where(penetrating, p - tau[:, None, None] * g, p)
+        sums = p.sum(axis=A)
         lifted = sums <= 0.0
         if not lifted.any():
             break
         tau = np.where(lifted, 0.5 * tau, tau)
-    scale = total / p.sum(axis=1)
-    return p * scale[:, None], clipped, scale
+    scale = total / p.sum(axis=A)
+    return p * scale[:, None, None], clipped, scale
 
 
 def _complementary_rows(u, h, p, allowed) -> np.ndarray:
     """cg._complementary, row by row: nothing outside the contact set penetrates beyond PENETRATION."""
     on = p > 0
     g = u + h
-    alpha = (g * on).sum(axis=1) / np.maximum(on.sum(axis=1), 1)
+    alpha = (g * on).sum(axis=A) / np.maximum(on.sum(axis=A), 1)
     outside = ~on & allowed
-    scale = np.maximum(np.where(on, np.abs(u), 0.0).max(axis=1), 1e-300)
-    worst = np.where(outside, g - alpha[:, None], np.inf).min(axis=1)
+    scale = np.maximum(np.where(on, np.abs(u), 0.0).max(axis=A), 1e-300)
+    worst = np.where(outside, g - alpha[:, None, None], np.inf).min(axis=A)
     return worst >= -PENETRATION * scale
