@@ -16,6 +16,11 @@ then −δ → +δ → −δ (the loop that is recorded and wears).  At each inc
   wear along its own travel over the flat (:func:`fretsim.wear.sweep_deposit`), which with equal travel
   everywhere is exactly the paper's stroke average.
 
+The resolved stroke's increments are solved together where they can be (:mod:`fretsim.cycle.resolved`): all
+positions' normal contacts as the layers of one stack, the travels of increments that slide entirely at ±μp at
+once — the same discretisation to the same travel tolerance, at a quarter of the time in 2D; one by one in partial
+slip, on large 3D grids (no gain there), on refinement's coarse grid, or without a warm start.
+
 The normal and tangential problems are solved uncoupled: exact for elastically similar bodies, otherwise the
 normal displacement the shear causes (∝ Dundurs' β) is neglected (the plan warns where βμ matters).  The
 convected strain (a flat point's elastic displacement changes as the load slides over it, ∝ μp/E* times the

@@ -3,8 +3,8 @@
 The resolved stroke solves the normal contact at each increment with every point of the moving body over the
 point of the worn flat it has reached, and the tangential contact that says where the points go next.  Taken
 one increment at a time that is a score of small solves a cycle, each paying numpy's cost per call many times
-over its arithmetic (McColl 185 N 2D: 30 calls an increment, no hot spot).  Here the positions are rows of one
-stack:
+over its arithmetic (McColl 185 N 2D: 30 calls an increment, no hot spot).  Here the positions are layers of
+one stack (where the stack is small enough to gain: STACK_LIMIT):
 
 * **where the points go** (:func:`travels`): in gross slip the whole contact slides at μp after the first
   increment or two past a reversal, so each increment's traction is ±μp and its travel ΔU − KΔq follows from one
@@ -36,6 +36,11 @@ PARTIAL_SHARE = 4  # a step's passes go increment by increment where predicting 
 #                    tangential solver on more than 1/4 of the increments (partial slip: a solve per increment, as the
 #                    pass one by one does, and the stack then saves little; the ball at 0.7 µm was 1.25× slower
 #                    stacked); gross slip needs it only just past the reversals
+STACK_LIMIT = 60_000  # elements of a whole stack (positions × grid) beyond which a cycle goes increment by increment:
+#                      the stacked arrays then leave the cache and numpy's cost per call no longer dominates — McColl
+#                      185 N 3D (19 × 27 × 263 = 135 000) took 97.9 s stacked against 87.5 s one by one (84 s with
+#                      the normal solves in chunks), where 2D (19 × 427) is 4.2× faster stacked and the ball in gross
+#                      slip (19 × 25 × 85 = 40 000) 1.5×
 MAX_ROUNDS = 4  # normal solves of the stack before the cycle goes increment by increment (2 is usual: the second
 #                 re-solves the few positions whose travel the first pressure moved by more than the tolerance)
 
@@ -96,8 +101,8 @@ def positions(member, wear_moving, wear_stationary, normal, du: np.ndarray, gues
     of the step's previous pass, else the travels at ``guess`` everywhere."""
     rows = getattr(normal, "rows", None)
     m, shape = du.size, member.grid.shape
-    if rows is None or (predicted is None and guess is None) or predicted == ():  # (): the last pass went one by one
-        return None
+    if rows is None or (predicted is None and guess is None) or predicted == () or m * member.grid.size > STACK_LIMIT:
+        return None  # (predicted (): the step's last pass went one by one)
     moving = wear_moving + (np.stack(correction) if correction is not None else 0.0)
     moving = np.broadcast_to(moving, (m,) + shape)
     flat = np.broadcast_to(wear_stationary, (m,) + shape)

@@ -1,9 +1,9 @@
 """The loop's normal contact as the cycle members call it: one gap at a time, or a stack of them at once.
 
-A resolved fretting cycle solves the contact at every position of the stroke; on a 2D grid the positions are
-solved together (:func:`fretsim.solvers.rows.solve_rows`), each checked as the loop checks one solve.  Where
-they cannot be (refinement's coarse grid, an operator that is not a convolution, a solver other than cg),
-:meth:`NormalSolve.rows` says so (None) and the member solves them one by one.
+A resolved fretting cycle solves the contact at every position of the stroke; the positions are solved together
+(:func:`fretsim.solvers.rows.solve_rows`), each checked as the loop checks one solve.  Where they cannot be
+(refinement's coarse grid, an operator that is not a convolution, a solver other than cg), :meth:`NormalSolve.rows`
+says so (None) and the member solves them one by one.
 """
 from __future__ import annotations
 

@@ -264,8 +264,8 @@ def _check_incremental(case: Case, grids, model, plan: Plan, transition: Optiona
 def _warn_resolved(case: Case, plan: Plan) -> None:
     plan.add(Choice("model.gap", case.gap_model, "not used: the stroke is resolved, each position sees the "
                                                  "flat's wear under it", case.gap_model != "auto"))
-    plan.warnings.append("model.stroke resolved: the cost estimate times a cycle on the unworn contact, and a worn "
-                         "contact's windows are wider: McColl 185 N took about its estimate in 2D and 3× it in 3D "
+    plan.warnings.append("model.stroke resolved: the cost estimate times a cycle on the unworn contact and doubles "
+                         "it for the worn contact's wider windows; McColl's cases took 0.6–1.6× their estimates "
                          "(README: the resolved stroke)")
     if case.increments < 5:
         plan.warnings.append(f"model.increments {case.increments} with the stroke resolved: the contact "
