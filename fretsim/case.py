@@ -242,8 +242,8 @@ SCHEMA: dict[str, dict[str, Key]] = {
         "stroke": Key("choice", "the normal contact at mid-stroke only (mid_stroke, the paper) or at each increment "
                                 "of the cycle with the moving body where it is over the worn flat (resolved); "
                                 "auto: with model.slip coulomb on a line contact, resolved where 2D proxy runs "
-                                "show the mid-stroke depths or widths more than model.accuracy/3 away (it costs "
-                                "about 12× the mid-stroke run in 2D: README), else mid_stroke (uniform slip, partial slip, "
+                                "show the mid-stroke depths or widths more than model.accuracy/3 away (its loop costs "
+                                "about 6.6× the mid-stroke run's in 2D, 23× in 3D: README), else mid_stroke (uniform slip, partial slip, "
                                 "point contacts: said why); resolved needs loading.friction_coefficient",
                       "auto",
                       choices=STROKE_MODELS),
