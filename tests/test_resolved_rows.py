@@ -206,3 +206,25 @@ def test_a_3d_resolved_run_stepped_as_stacks_stays_within_the_estimates_of_the_r
     for key in ("centre_wear_depth_stationary_um", "max_wear_depth_moving_um"):
         assert abs(a[key] / b[key] - 1.0) <= allowed, key
     assert a["wear_volume_stationary_mm3"] == pytest.approx(b["wear_volume_stationary_mm3"], rel=1e-5)
+
+
+def test_a_row_started_on_one_element_takes_the_single_solves_admitting_step_not_a_failure():
+    """A start on one element (a cold start where one asperity stands out: its closest point alone) has a zero
+    residual, so the first iteration takes no step and puts pressure on the penetrating neighbours (solve_cg's
+    admit branch).  The stacked row must do the same, not end as a failure because its pressure change was never
+    measured (it was then handed back to be solved alone): the same iterations and the same pressure to round-off
+    (1e-12 of the peak; measured 0), next to a row that converges normally."""
+    from fretsim.solvers.cg import solve_cg
+    from fretsim.solvers.rows import cg_rows
+    grid, c, a = _cylinder(n=101)
+    smooth = grid.x[None, :] ** 2 / (2 * RADIUS)
+    asperity = smooth.copy()
+    asperity[0, 50] -= 50 * grid.dx ** 2 / (2 * RADIUS)
+    gaps = np.stack([smooth, asperity])
+    h = asperity[0]
+    assert np.count_nonzero(h <= h.min() + 0.5 * (np.percentile(h, 10) - h.min()) + 1e-300) == 1  # one element
+    pressures, _, ok, its, _ = cg_rows(c, gaps, LOAD, np.zeros(gaps.shape), 1e-10)
+    for k in range(2):
+        one = solve_cg(c, gaps[k], LOAD, None, 1e-10)
+        assert one.success and ok[k] and its[k] == one.iterations, k
+        assert np.abs(pressures[k] - one.pressure).max() <= 1e-12 * one.pressure.max(), k

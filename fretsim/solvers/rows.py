@@ -102,7 +102,7 @@ def cg_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float):
         z = precond(g * w) * w
         z -= w * (z.sum(axis=A) / count)[:, None, None]
         gz = (g * z).sum(axis=A)
-        beta = np.where(delta > 0, delta * gz / gz_old, 0.0)
+        beta = np.where(delta > 0, delta * gz / np.where(gz_old != 0.0, gz_old, 1.0), 0.0)  # (0 after a still row)
         t = (z + beta[:, None, None] * t) * w
         gz_old = gz
         r_raw = op(t)
@@ -122,8 +122,9 @@ def cg_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float):
         u = scale[:, None, None] * (u - tau[:, None, None] * r_raw)
         if recompute.any():
             u[recompute] = op(p[recompute])
-        err = np.where(still, err, np.abs(p - p_old).sum(axis=A) / total)
-        bad = ~np.isfinite(err)
+        change = np.abs(p - p_old).sum(axis=A) / total
+        bad = ~still & ~np.isfinite(change)  # (a row that took no step keeps its last change, inf before its first)
+        err = np.where(still, err, change)
         fin = done | bad | ((err < tol) & _complementary_rows(u, hl, p, al) & ~still)
         if fin.any() or it == max_iter:
             if it == max_iter:
