@@ -26,12 +26,17 @@ STACK_ELEMENTS = 32_000  # elements of the windows solved in one stack: beyond, 
 def solve_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float) -> list:
     """The contacts of the layers of ``gaps`` (m, My, Mx) on the grid of ``op`` (a convolution), warm-started from
     ``p0`` (m, My, Mx), each carrying ``load``: a ContactResult per layer, or None where the layer must be solved
-    alone (it did not converge on the window, or its contact outgrew it)."""
+    alone (it did not converge on the window, or its contact outgrew it, or its gap is one the single solve refuses:
+    NaN, −inf, or infinite everywhere it may touch)."""
     m, ny, nx = gaps.shape
     on = p0 > 0
     if not on.any():
         return [None] * m
     rows, cols = _span(on.any(axis=(0, 2)), ny), _span(on.any(axis=(0, 1)), nx)
+    usable = ~(np.isnan(gaps) | np.isneginf(gaps)).any(axis=(1, 2)) & np.isfinite(gaps[:, rows, cols]).any(axis=(1, 2))
+    if not usable.all():  # a NaN or −inf gap, or none finite on the window: the single solve says what is wrong
+        rest = iter(solve_rows(op, gaps[usable], load, p0[usable], tol) if usable.any() else ())
+        return [next(rest) if u else None for u in usable]
     size = (rows.stop - rows.start) * (cols.stop - cols.start)
     if m > 1 and m * size > STACK_ELEMENTS:  # in chunks that stay in the cache (and whose windows are narrower)
         k = max(1, STACK_ELEMENTS // size)
