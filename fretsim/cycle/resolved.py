@@ -101,7 +101,8 @@ def positions(member, wear_moving, wear_stationary, normal, du: np.ndarray, gues
     of the step's previous pass, else the travels at ``guess`` everywhere."""
     rows = getattr(normal, "rows", None)
     m, shape = du.size, member.grid.shape
-    if rows is None or (predicted is None and guess is None) or predicted == () or m * member.grid.size > STACK_LIMIT:
+    if rows is None or not getattr(normal, "stacks", True) or (predicted is None and guess is None) or \
+            predicted == () or m * member.grid.size > STACK_LIMIT:
         return None  # (predicted (): the step's last pass went one by one)
     moving = wear_moving + (np.stack(correction) if correction is not None else 0.0)
     moving = np.broadcast_to(moving, (m,) + shape)

@@ -28,13 +28,19 @@ class NormalSolve:
     def __call__(self, seen, guess, extra=None, load: Optional[float] = None, cycle: int = 0):
         return self.loop.normal(seen, guess, extra, load=load, cycle=cycle)
 
+    @property
+    def stacks(self) -> bool:
+        """Whether :meth:`rows` can solve here (asked before the member predicts where the points go)."""
+        s = self.loop.s
+        return s.coarse is None and s.method == "cg" and isinstance(s.compliance, Convolution)
+
     def rows(self, seen: np.ndarray, guess: np.ndarray, extra=None, load: Optional[float] = None, cycle: int = 0):
         """(pressures (m, My, Mx), a ContactResult per layer) for the gaps ε + ``seen`` (m, My, Mx), warm-started
         from ``guess`` (m, My, Mx); None where they cannot be solved together.  A row the stack did not settle is
         solved alone, with the single solve's fallbacks and checks; every row is checked as a single solve is."""
         loop = self.loop
         s = loop.s
-        if s.coarse is not None or s.method != "cg":
+        if not self.stacks:
             return None
         op = s.compliance
         if extra is not None:
