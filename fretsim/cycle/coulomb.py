@@ -43,7 +43,6 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 from functools import cached_property
-from typing import Optional
 
 import numpy as np
 
@@ -212,7 +211,8 @@ class CoulombCycle:
                 p, res, q_new, ds, stuck = self._resolved_increment(wear_moving, wear_stationary, normal, q, s, du,
                                                                     p_prev, ds_prev, du_prev, extra, cycle, tally,
                                                                     shift)
-                visits.append((p, s, s + ds))
+                if corrected:
+                    visits.append((p, s, s + ds))
             else:
                 (p, res), (q_new, ds, stuck, its) = fixed, self._tangential(q, fixed[0], du)
                 tally.iterations += its
