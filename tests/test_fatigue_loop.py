@@ -73,12 +73,14 @@ def _sliding_history():
     return x, dx, z, ps, qs, np.array(travels), fine
 
 
-@pytest.mark.parametrize("gather", [0, 100])  # the 5° pass by running filters, and with the histories gathered
-def test_a_rigidly_sliding_state_counts_every_position_on_its_way(gather, monkeypatch):
-    import fretsim.fatigue.swt as swt
-    monkeypatch.setattr(swt, "GATHER", gather)
+# the 1° pass, over each point's gathered history, and the 5° pass alone (its running extremes along x): nothing is
+# refined where the share asked is above the peak
+@pytest.mark.parametrize("fine_share", [FINE_SHARE, 2.0])
+def test_a_rigidly_sliding_state_counts_every_position_on_its_way(fine_share, monkeypatch):
     """Four states (each end of each half-stroke) with the slides marked give the SWT of all 22 positions
     computed one by one: the sliding maximum is exact on the grid (1e-12)."""
+    import fretsim.fatigue.swt as swt
+    monkeypatch.setattr(swt, "FINE_SHARE", fine_share)
     x, dx, z, ps, qs, travels, fine = _sliding_history()
     slid = slides(np.ones_like(ps), travels, dx)
     assert slid == {1: 10, 3: -10}

@@ -121,19 +121,20 @@ def swt_2d(history: tuple, youngs: float, poisson: float, angles: int = ANGLES) 
 
 COARSE_ANGLES = 36  # the fast search's first pass: every 5°
 FINE_SHARE = 0.01  # ... refined where it found at least this share of the field's peak
-GATHER = 2  # windows' positions, per state, up to which the 5° pass gathers each point's whole history (beyond,
-#             running filters per plane were faster: McColl-size fields, measured)
 FINE_HALF = 4  # ... then every degree within ±4° of each point's two best: the 1° optimum of a π-periodic function
 #               whose peaks the 5° pass has bracketed (tests/test_fatigue_loop.py: equal to the full search)
+CHUNK_2D = 60_000  # planes × history entries × points per matrix product: the work arrays stay in the cache
 
 
 def swt_search(history: tuple, youngs: float, poisson: float, slides: Optional[dict] = None,
                skip: float = 0.0) -> CriticalPlane:
     """:func:`swt_2d`'s critical plane to the same degree in a fraction of the work: a 5° pass, then each point's
     two best planes' neighbourhoods degree by degree.  On a plane of normal angle φ the normal stress is
-    a + b·cos 2φ + c·sin 2φ (a, b, c the mean, half-difference and shear of the in-plane stresses), and so is the
-    normal strain.  The second pass is made where the first found at least FINE_SHARE of the field's peak;
-    elsewhere the 5° value stands (its damage rate, ∝ SWT^(−1/2b) ≈ SWT^5, is 10⁻¹⁰ of the peak's).
+    a + b·cos 2φ + c·sin 2φ (a, b, c the mean, half-difference and shear of the in-plane stresses), and in plane
+    strain the normal strain is k·((1 − 2ν)·a + b·cos 2φ + c·sin 2φ), k = (1 + ν)/E: both, for many planes at
+    many points, are one matrix product (BLAS) of the planes' weights with the points' (a, b, c).  The second
+    pass is made where the first found at least FINE_SHARE of the field's peak; elsewhere the 5° value stands
+    (its damage rate, ∝ SWT^(−1/2b) ≈ SWT^5, is 10⁻¹⁰ of the peak's).
 
     ``slides`` {state k: m}: the states reached by sliding rigidly, with their tractions as they are, over m
     elements of the last axis (signed) since the state before — so that on the way the field at a point was state
@@ -143,15 +144,13 @@ def swt_search(history: tuple, youngs: float, poisson: float, slides: Optional[d
     ``skip`` > 0: points whose bound max σ₁·(max ε₁ − min ε₃)/2 (no plane's SWT exceeds it) is below ``skip`` of
     the field's largest bound are not searched (0 there): for the damage alone, where they count nothing."""
     sxx, szz, sxz = (np.asarray(a, dtype=float) for a in history)
-    exx, ezz, gxz = plane_strain_strains(sxx, szz, sxz, youngs, poisson)
     shape = sxx.shape[1:]
-    flat = lambda a: a.reshape(a.shape[0], -1, a.shape[-1])  # noqa: E731  (state, leading points, x)
-    s_abc = tuple(flat(a) for a in (0.5 * (sxx + szz), 0.5 * (sxx - szz), sxz))
-    e_abc = tuple(flat(a) for a in (0.5 * (exx + ezz), 0.5 * (exx - ezz), 0.5 * gxz))
+    nx = shape[-1]
+    abc = np.stack([0.5 * (sxx + szz), 0.5 * (sxx - szz), sxz]).reshape(3, sxx.shape[0], -1, nx)  # (3, state, row, x)
     slides = {k: m for k, m in (slides or {}).items() if m}
     rows, cols = slice(None), slice(None)
     if skip > 0:  # the bounding box of the points worth searching (with the windows' reach along x)
-        bound = _bound(s_abc, e_abc, slides)
+        bound = _bound(abc, slides, youngs, poisson)
         on = bound >= skip * bound.max() if bound.size and bound.max() > 0 else np.zeros(bound.shape, bool)
         if not on.any():
             return CriticalPlane(np.zeros(shape), np.zeros(shape))
@@ -159,172 +158,143 @@ def swt_search(history: tuple, youngs: float, poisson: float, slides: Optional[d
         reach = max((abs(m) for m in slides.values()), default=0)
         rows = slice(int(r[0]), int(r[-1]) + 1)
         cols = slice(max(0, int(c[0]) - reach), int(c[-1]) + reach + 1)
-    plane = _search_field(tuple(a[:, rows, cols] for a in s_abc), tuple(a[:, rows, cols] for a in e_abc), slides)
-    best, where = np.zeros(s_abc[0].shape[1:]), np.zeros(s_abc[0].shape[1:])
-    best[rows, cols], where[rows, cols] = plane
-    return CriticalPlane(best.reshape(shape), where.reshape(shape))
+    part = np.ascontiguousarray(abc[:, :, rows, cols])
+    coarse = _coarse_field(part, slides, _weights(np.arange(COARSE_ANGLES) * (180 // COARSE_ANGLES), youngs, poisson))
+    weights = lambda degrees: _weights(degrees, youngs, poisson)  # noqa: E731
+    best, where = _refine(coarse, lambda ref, degrees, sel: _values_at(part, slides, ref, degrees, sel, weights))
+    out, angle = np.zeros(abc.shape[2:]), np.zeros(abc.shape[2:])
+    out[rows, cols], angle[rows, cols] = best.reshape(part.shape[2:]), where.reshape(part.shape[2:])
+    return CriticalPlane(out.reshape(shape), angle.reshape(shape))
 
 
-def _bound(s_abc, e_abc, slides: dict) -> np.ndarray:
-    """max σ₁·(max ε₁ − min ε₃)/2 over the history at each point: no plane's SWT exceeds it."""
-    def extreme(abc, sign, pick):
-        v = abc[0] + sign * np.hypot(abc[1], abc[2])
-        out = v.max(axis=0) if pick is np.maximum else v.min(axis=0)
-        for k, m in slides.items():
-            out = pick(out, _sliding(v[k].T, m, pick).T)
-        return out
-    return (np.maximum(extreme(s_abc, 1, np.maximum), 0.0) * 0.5 *
-            (extreme(e_abc, 1, np.maximum) - extreme(e_abc, -1, np.minimum)))
+def _weights(degrees, youngs: float, poisson: float) -> np.ndarray:
+    """(2 × planes, 3): the rows (1, cos 2φ, sin 2φ) that give each plane's normal stress from a point's (a, b, c),
+    then k·(1 − 2ν, cos 2φ, sin 2φ), its normal strain (plane strain: the strains' mean is k(1 − 2ν) times the
+    stresses', their half-difference and shear k times)."""
+    phi = np.asarray(degrees, dtype=float) * (np.pi / ANGLES)
+    one, c2, s2 = np.ones(phi.size), np.cos(2.0 * phi), np.sin(2.0 * phi)
+    k = (1.0 + poisson) / youngs
+    return np.concatenate([np.stack([one, c2, s2], axis=1), k * np.stack([(1.0 - 2.0 * poisson) * one, c2, s2],
+                                                                        axis=1)])
+
+
+def _bound(abc: np.ndarray, slides: dict, youngs: float, poisson: float) -> np.ndarray:
+    """max σ₁·(max ε₁ − min ε₃)/2 over the history at each point (row, x): no plane's SWT exceeds it."""
+    r = np.hypot(abc[1], abc[2])
+    k, mean = (1.0 + poisson) / youngs, (1.0 - 2.0 * poisson) * abc[0]
+    parts = [(abc[0] + r, np.maximum), (k * (mean + r), np.maximum), (k * (mean - r), np.minimum)]
+    out = []
+    for v, pick in parts:
+        for t, m in slides.items():
+            v[t] = _window(v[t], _reach(m), pick)
+        out.append(v.max(axis=0) if pick is np.maximum else v.min(axis=0))
+    return np.maximum(out[0], 0.0) * 0.5 * (out[1] - out[2])
+
+
+def _reach(m: int) -> int:
+    """A 2D slide of m elements passes m + 1 positions (0 … m): :func:`_window`'s count, signed."""
+    return m + (1 if m > 0 else -1)
+
+
+def _coarse_field(abc: np.ndarray, slides: dict, weights: np.ndarray) -> np.ndarray:
+    """SWT on each plane of ``weights`` (:func:`_weights`) at every point: (point, plane), the points (row, x) in
+    order.  A few rows at a time, each state's normal stresses and strains on every plane are one matrix product,
+    and a sliding state's window is a running extreme of them along x (log₂ m comparisons a point)."""
+    _, states, nrows, nx = abc.shape
+    planes = weights.shape[0] // 2
+    out = np.empty((nrows, nx, planes))
+    group = max(1, CHUNK_2D // (2 * planes * nx))
+    for lo in range(0, nrows, group):
+        hi = min(nrows, lo + group)
+        top = high = low = None
+        for t in range(states):
+            v = (weights @ abc[:, t, lo:hi].reshape(3, -1)).reshape(2 * planes, hi - lo, nx)
+            if t in slides:  # (the largest over the window for the stresses and strains at once, the least for
+                m = _reach(slides[t])  # the strains)
+                v, e_low = _window(v, m, np.maximum), _window(v[planes:], m, np.minimum)
+            else:
+                e_low = v[planes:]
+            s_top, e_high = v[:planes], v[planes:]
+            if top is None:
+                top, high, low = s_top.copy(), e_high.copy(), e_low.copy()
+            else:
+                np.maximum(top, s_top, out=top)
+                np.maximum(high, e_high, out=high)
+                np.minimum(low, e_low, out=low)
+        np.maximum(top, 0.0, out=top)
+        high -= low
+        high *= 0.5
+        top *= high
+        out[lo:hi] = top.transpose(1, 2, 0)
+    return out.reshape(nrows * nx, planes)
+
+
+def _values_at(abc: np.ndarray, slides: dict, ref: np.ndarray, degrees: np.ndarray, points: np.ndarray,
+               weights) -> np.ndarray:
+    """SWT at the flat indices ``points`` (row, x) on the planes ``ref``·5° + ``degrees``·1° (each point its own
+    ``ref``: its (b, c) turned by 2·ref·5° so that the planes' weights are the same for all): (degrees, points)."""
+    hist = _gathered_2d(abc, slides, points)  # (3, history, point)
+    phi = ref * (2.0 * np.pi / COARSE_ANGLES)  # 2φ of each point's reference plane
+    c, s = np.cos(phi), np.sin(phi)
+    turned = np.stack([hist[0], hist[1] * c + hist[2] * s, hist[2] * c - hist[1] * s])
+    w = weights(degrees)
+    planes, length = len(degrees), turned.shape[1]
+    out = np.empty((planes, len(points)))
+    size = max(1, CHUNK_2D // (2 * planes * length))
+    for lo in range(0, len(points), size):
+        block = turned[:, :, lo:lo + size]
+        v = (w @ block.reshape(3, -1)).reshape(2 * planes, length, block.shape[2])
+        out[:, lo:lo + size] = np.maximum(v[:planes].max(axis=1), 0.0) * 0.5 * (
+            v[planes:].max(axis=1) - v[planes:].min(axis=1))
+    return out
+
+
+def _gathered_2d(abc: np.ndarray, slides: dict, points: np.ndarray) -> np.ndarray:
+    """The histories (3, history, point) at the flat indices ``points`` (row, x): the states, then each sliding
+    state's window (its values 1 … |m| elements on, held at the grid's ends: a repeat changes no extreme)."""
+    nx = abc.shape[-1]
+    r, x = np.divmod(points, nx)
+    flat = abc.reshape(3, abc.shape[1], -1)
+    parts = [flat[:, :, points]]
+    for k, m in slides.items():
+        at = np.clip(x[None, :] + np.sign(m) * np.arange(1, abs(m) + 1)[:, None], 0, nx - 1)
+        parts.append(flat[:, k][:, r * nx + at])
+    return np.concatenate(parts, axis=1)
 
 
 def _refine(coarse: np.ndarray, value) -> tuple:
     """From the 5° pass's values (point, angle): each point's two best planes' neighbourhoods degree by degree,
     where the 5° value is at least FINE_SHARE of the peak (a fretting cycle's mirror-image planes often tie to
     round-off, and the pass about the wrong one of two near-equal peaks can miss the best by 10 % or more).
-    ``value(phi, selection)`` → the SWT at the selected points on their planes φ, phi (planes, selection)."""
+    ``value(ref, degrees, selection)`` → the SWT at the selected points on the planes ref·5° + degrees·1°
+    (degrees, selection)."""
     step = np.pi / COARSE_ANGLES
-    order = np.argsort(coarse, axis=1)  # (each point's angles in a row: the sort reads them contiguous)
-    best = np.take_along_axis(coarse, order[:, -1:], 1)[:, 0]
-    where = order[:, -1] * step
-    sel = np.flatnonzero(best >= FINE_SHARE * best.max()) if best.max() > 0 else np.zeros(0, int)
-    top, second = order[sel, -1], order[sel, -2]
+    per = ANGLES // COARSE_ANGLES
+    top = np.argmax(coarse, axis=1)
+    best, where = coarse[np.arange(len(coarse)), top], top * step
+    sel = np.flatnonzero(best >= FINE_SHARE * best.max()) if best.size and best.max() > 0 else np.zeros(0, int)
+    top, rest = top[sel], coarse[sel]
+    rest[np.arange(sel.size), top] = -np.inf
+    second = np.argmax(rest, axis=1)
     ks = np.array([k for k in range(-FINE_HALF, FINE_HALF + 1) if k])
-    centres = np.concatenate([np.repeat(top[None], ks.size, 0), np.repeat(second[None], ks.size, 0)])
-    offsets = np.concatenate([ks, ks])[:, None] * np.ones(sel.size, int)  # (16, sel): the planes in degrees
     # the two best are next to each other at almost every point: their neighbourhoods share four planes, each
-    # evaluated once (the planes, in degrees from the lower of the two, are then the same twelve at every point)
-    low = np.where((second - top) % COARSE_ANGLES == 1, top, second)
-    pair = ((second - top) % COARSE_ANGLES == 1) | ((top - second) % COARSE_ANGLES == 1)
-    degrees = (centres - low) % COARSE_ANGLES * (ANGLES // COARSE_ANGLES) + offsets  # (16, sel), from `low`
-    shared = np.unique(degrees[:, pair], axis=None) if pair.any() else np.zeros(0, int)
-    values = np.empty(degrees.shape)
-    if pair.any():
-        phi = np.mod(low[pair] * step + shared[:, None] * (np.pi / ANGLES), np.pi)
-        got = value(phi, sel[pair])
-        values[:, pair] = got[np.searchsorted(shared, degrees[:, pair]), np.arange(pair.sum())]
-    if (~pair).any():
-        values[:, ~pair] = value(np.mod(centres[:, ~pair] * step + offsets[:, ~pair] * (np.pi / ANGLES), np.pi),
-                                 sel[~pair])
+    # evaluated once (in degrees from the lower of the two, the same twelve at every such point)
+    adjacent = (second - top) % COARSE_ANGLES == 1
+    pair = adjacent | ((top - second) % COARSE_ANGLES == 1)
+    low = np.where(adjacent, top, second)
+    shared = np.union1d(ks, ks + per)
     b, w = best[sel], where[sel]
-    for v, d in zip(values, np.mod(centres * step + offsets * (np.pi / ANGLES), np.pi)):  # in the search's order
-        better = v > b
-        b, w = np.where(better, v, b), np.where(better, d, w)
+    for mask, ref, degrees in ((pair, low, shared), (~pair, top, ks), (~pair, second, ks)):
+        if not mask.any():
+            continue
+        got = value(ref[mask], degrees, sel[mask])  # (degrees, points)
+        k = np.argmax(got, axis=0)  # (ties: the 5° best, then the first plane listed)
+        v = got[k, np.arange(k.size)]
+        better = v > b[mask]
+        at = np.flatnonzero(mask)[better]
+        b[at], w[at] = v[better], np.mod(ref[at] * step + degrees[k[better]] * (np.pi / ANGLES), np.pi)
     best[sel], where[sel] = b, w
     return best, where
-
-
-def _value_pts(s_pts: tuple, e_pts: tuple, phi, work: Optional[tuple] = None) -> np.ndarray:
-    """SWT on the plane(s) φ at points whose whole history (states and windows) is gathered: (history, points).
-    ``work``: two arrays of the histories' shape to sum in (a search's planes reuse them)."""
-    c2, s2 = np.cos(2.0 * phi), np.sin(2.0 * phi)
-    work = work if work is not None else _work(s_pts[0])
-    sn = _project(s_pts, c2, s2, work)
-    s_hi = sn.max(axis=0)
-    en = _project(e_pts, c2, s2, work)  # (over sn, done with)
-    return np.maximum(s_hi, 0.0) * 0.5 * (en.max(axis=0) - en.min(axis=0))
-
-
-def _work(like: np.ndarray) -> tuple:
-    """Two arrays to sum in: fresh arrays above glibc's mmap threshold (128 kB) are mapped and faulted in anew at
-    every allocation, which made a plane's sums 3x slower than in arrays reused (9 x 3010 points, measured)."""
-    return np.empty_like(like), np.empty_like(like)
-
-
-def _project(abc: tuple, c2, s2, work: Optional[tuple] = None) -> np.ndarray:
-    """a + b·cos 2φ + c·sin 2φ, summed in that order (into ``work[0]``, with ``work[1]`` for the third term)."""
-    out, tmp = work if work is not None else (None, None)
-    out = np.multiply(abc[1], c2, out=out)
-    out += abc[0]  # (a + b·c2 as b·c2 + a: the same rounding)
-    out += np.multiply(abc[2], s2, out=tmp)
-    return out
-
-
-def _search_field(s_abc, e_abc, slides: dict) -> tuple:
-    """The search over a (state, leading, x) field: the 5° pass over the field plane by plane
-    (:func:`_coarse_field`), or with every point's history gathered (the states and each window's positions: one
-    array operation per plane) where GATHER says; the second pass at the points that need it, their windows
-    gathered."""
-    step = np.pi / COARSE_ANGLES
-    shape = s_abc[0].shape[1:]
-    if sum(abs(m) for m in slides.values()) < GATHER * s_abc[0].shape[0]:
-        rows, cols = (a.ravel() for a in np.indices(shape))
-        s_all, e_all = _at_points(s_abc, slides, rows, cols), _at_points(e_abc, slides, rows, cols)
-        work = _work(s_all[0])
-        coarse = np.array([_value_pts(s_all, e_all, phi, work) for phi in np.arange(COARSE_ANGLES) * step]).T
-    else:
-        coarse = _coarse_field(s_abc, e_abc, slides, np.arange(COARSE_ANGLES) * step)
-    nx = shape[-1]
-
-    def value(phi, sel):
-        rows, cols = np.divmod(sel, nx)
-        pts = (_at_points(s_abc, slides, rows, cols), _at_points(e_abc, slides, rows, cols))
-        work = _work(pts[0][0])
-        return np.array([_value_pts(*pts, row, work) for row in phi])
-
-    best, where = _refine(np.ascontiguousarray(coarse), value)
-    return best.reshape(shape), where.reshape(shape)
-
-
-def _coarse_field(s_abc, e_abc, slides: dict, phis: np.ndarray) -> np.ndarray:
-    """SWT on each plane φ at every point: (point, angle), the points (leading, x) in order.  A state's normal
-    stress and strain are projected once per plane over the field, and a sliding state's window is a running
-    extreme of that projection along x: each position of the window costs one comparison, not (gathered) a
-    projection."""
-    # (the cosines as the gathered pass takes them, one by one: the same planes to the last bit)
-    c2 = np.array([np.cos(2.0 * phi) for phi in phis])[:, None, None]
-    s2 = np.array([np.sin(2.0 * phi) for phi in phis])[:, None, None]
-
-    def extremes(abc, low: bool):
-        hi = lo = None
-        for t in range(abc[0].shape[0]):
-            # laid (angle, x, leading): the planes' sums run over whole contiguous fields, a window's shift too
-            values = _project(tuple(np.ascontiguousarray(a[t].T) for a in abc), c2, s2)
-            for pick in (np.maximum, np.minimum)[:1 + low]:
-                own = [values] + ([_sliding(values.transpose(1, 0, 2), slides[t], pick).transpose(1, 0, 2)]
-                                  if t in slides else [])
-                kept = hi if pick is np.maximum else lo
-                for v in own:
-                    kept = v.copy() if kept is None else pick(kept, v, out=kept)
-                hi, lo = (kept, lo) if pick is np.maximum else (hi, kept)
-        return hi, lo
-
-    s_hi, _ = extremes(s_abc, False)
-    e_hi, e_lo = extremes(e_abc, True)
-    out = np.maximum(s_hi, 0.0) * 0.5 * (e_hi - e_lo)  # (angle, x, leading)
-    return out.transpose(2, 1, 0).reshape(-1, len(phis))
-
-
-def _at_points(abc: tuple, slides: dict, rows: np.ndarray, cols: np.ndarray) -> tuple:
-    """(a, b, c) at the points (rows, cols) over the states and, for each sliding state, every position of its
-    window (the state's values m' elements further on, held at the grid's ends): arrays (history, points), so that
-    each point's own planes are evaluated in one pass."""
-    nx = abc[0].shape[-1]
-    out = []
-    for arr in abc:
-        parts = [arr[:, rows, cols]]
-        for k, m in slides.items():
-            at = np.clip(cols[None, :] + np.sign(m) * np.arange(1, abs(m) + 1)[:, None], 0, nx - 1)
-            parts.append(arr[k][rows[None, :], at])
-        # C order: a fancy index over the states leaves them the fast axis, and the reductions over that short
-        # axis ran 25x slower (55 µs instead of 2 for 3 states x 1400 points)
-        out.append(np.ascontiguousarray(np.concatenate(parts, axis=0)))
-    return tuple(out)
-
-
-def _sliding(values: np.ndarray, m: int, pick) -> np.ndarray:
-    """pick (np.maximum or np.minimum) over the window x + 1 … x + m along the first axis (x − |m| … x − 1 for
-    m < 0), the field held at its edges.  By doubling spans: log₂|m| + 1 comparisons a point whatever the window
-    (an extreme is exact in any grouping: the same values as one by one)."""
-    n, w = values.shape[0], abs(m)
-    held = np.repeat(values[-1:] if m > 0 else values[:1], w, axis=0)
-    padded = np.concatenate([values, held] if m > 0 else [held, values], axis=0)
-    run, span = padded, 1  # run[i]: the extreme of padded[i : i + span]
-    while 2 * span <= w:
-        run, span = pick(run[:-span], run[span:]), 2 * span
-    if span < w:
-        run = pick(run[:span - w], run[w - span:])
-    start = 1 if m > 0 else 0  # (padded's entry x + 1 is the field's x + 1; for m < 0 its entry x is x − |m|)
-    return run[start:start + n]
 
 
 def ruiz(tensile: np.ndarray, shear: np.ndarray, slip: np.ndarray) -> np.ndarray:
@@ -478,13 +448,23 @@ def swt_search_3d(history, youngs: float, poisson: float, skip: float = 0.0, ful
 
 def _window(a: np.ndarray, m: int, pick) -> np.ndarray:
     """``pick`` (np.maximum or np.minimum) of ``a`` over the |m| positions 0 … |m| − 1 elements on along the last
-    axis (towards +x for m > 0, −x for m < 0; positions beyond the array left out): log₂ |m| comparisons."""
-    out = np.array(a[..., ::-1] if m < 0 else a, copy=True)
-    span, width = 1, abs(m)
-    while span < width:
-        step = min(span, width - span)
-        pick(out[..., :-step], out[..., step:].copy(), out=out[..., :-step])
-        span += step
+    axis (towards +x for m > 0, −x for m < 0; positions beyond the array left out): log₂ |m| comparisons, each into
+    a fresh array (a sparse table: the extreme over 2s positions from two over s), the last two spans overlapping
+    (an extreme is exact in any grouping: the same values as one by one)."""
+    width = abs(m)
+    if width <= 1:
+        return np.array(a, copy=True)
+    src = a[..., ::-1] if m < 0 else a
+    n = src.shape[-1]
+    run, span = src, 1  # run[..., i]: the extreme of src[..., i : i + span]
+    while 2 * span <= width and span < n:
+        run, span = pick(run[..., :-span], run[..., span:]), 2 * span
+    out = np.empty(src.shape, dtype=np.result_type(src))
+    body = max(0, n - width + 1)  # the positions whose whole window lies inside
+    if body:
+        pick(run[..., :body], run[..., width - span:width - span + body], out=out[..., :body])
+    if body < n:  # the last width − 1: each the extreme of what is left of the row
+        out[..., body:] = pick.accumulate(src[..., body:][..., ::-1], axis=-1)[..., ::-1]
     return out[..., ::-1] if m < 0 else out
 
 
