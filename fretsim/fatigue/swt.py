@@ -62,7 +62,10 @@ class Basquin:
 
 
     def lives(self, swt: np.ndarray, longest: float = 1e30) -> np.ndarray:
-        """:meth:`life` at every entry of an array (bisection on log N, all entries at once)."""
+        """:meth:`life` at every entry of an array, by Newton's method on u = log 2N: log SWT(u) is a log-sum-exp
+        of two lines falling in u, convex, so Newton from the left of the root (the larger of the two terms'
+        own inversions, each below it) climbs to it monotonically, quadratically once near (a few steps to a part
+        in 10¹⁴, where bisection took 64)."""
         swt = np.asarray(swt, dtype=float)
         floor = max(self.swt(longest), self.endurance_limit if self.endurance_limit is not None else 0.0)
         out = np.full(swt.shape, np.inf)
@@ -70,12 +73,19 @@ class Basquin:
         if not live.any():
             return out
         target = swt[live]
-        lo, hi = np.full(target.shape, math.log(0.25)), np.full(target.shape, math.log(longest))
-        for _ in range(64):  # 2⁻⁶⁴ of the 32 decades: below a part in 10¹² of N
-            mid = 0.5 * (lo + hi)
-            above = self._swt_array(np.exp(mid)) > target
-            lo, hi = np.where(above, mid, lo), np.where(above, hi, mid)
-        out[live] = np.where(target >= self.swt(0.25), 0.25, np.exp(0.5 * (lo + hi)))
+        f, b, c = self.strength_coefficient, self.strength_exponent, self.ductility_exponent
+        ka, kb = math.log(f * f / self.youngs_modulus), math.log(f * self.ductility_coefficient)  # log of each term
+        ea, eb = 2.0 * b, b + c  # ... its slope in u
+        goal = np.log(target)
+        u = np.maximum((goal - ka) / ea, (goal - kb) / eb)  # where each term alone reaches the target: left of the root
+        for _ in range(60):
+            ta, tb = np.exp(ka + ea * u), np.exp(kb + eb * u)
+            step = (np.log(ta + tb) - goal) * (ta + tb) / (ea * ta + eb * tb)
+            u -= step
+            if not (np.abs(step) > 1e-15 * np.maximum(1.0, np.abs(u))).any():
+                break
+        lives = np.minimum(0.5 * np.exp(u), longest)
+        out[live] = np.where(target >= self.swt(0.25), 0.25, np.maximum(lives, 0.25))
         return out
 
     def _swt_array(self, cycles: np.ndarray) -> np.ndarray:
@@ -127,7 +137,7 @@ CHUNK_2D = 60_000  # planes × history entries × points per matrix product: the
 
 
 def swt_search(history: tuple, youngs: float, poisson: float, slides: Optional[dict] = None,
-               skip: float = 0.0) -> CriticalPlane:
+               skip: float = 0.0, worth=None) -> CriticalPlane:
     """:func:`swt_2d`'s critical plane to the same degree in a fraction of the work: a 5° pass, then each point's
     two best planes' neighbourhoods degree by degree.  On a plane of normal angle φ the normal stress is
     a + b·cos 2φ + c·sin 2φ (a, b, c the mean, half-difference and shear of the in-plane stresses), and in plane
@@ -142,7 +152,10 @@ def swt_search(history: tuple, youngs: float, poisson: float, slides: Optional[d
     window, exactly, however few states the cycle was cut into.
 
     ``skip`` > 0: points whose bound max σ₁·(max ε₁ − min ε₃)/2 (no plane's SWT exceeds it) is below ``skip`` of
-    the field's largest bound are not searched (0 there): for the damage alone, where they count nothing."""
+    the field's largest bound are not searched (0 there): for the damage alone, where they count nothing.
+
+    ``worth``: for the damage alone, a function of the first pass's field (the points' shape) that gives the points
+    where the second pass is worth making (besides FINE_SHARE); elsewhere the 5° value stands."""
     sxx, szz, sxz = (np.asarray(a, dtype=float) for a in history)
     shape = sxx.shape[1:]
     nx = shape[-1]
@@ -161,7 +174,13 @@ def swt_search(history: tuple, youngs: float, poisson: float, slides: Optional[d
     part = np.ascontiguousarray(abc[:, :, rows, cols])
     coarse = _coarse_field(part, slides, _weights(np.arange(COARSE_ANGLES) * (180 // COARSE_ANGLES), youngs, poisson))
     weights = lambda degrees: _weights(degrees, youngs, poisson)  # noqa: E731
-    best, where = _refine(coarse, lambda ref, degrees, sel: _values_at(part, slides, ref, degrees, sel, weights))
+    mask = None
+    if worth is not None:
+        first = np.zeros(abc.shape[2:])
+        first[rows, cols] = coarse.max(axis=1).reshape(part.shape[2:])
+        mask = np.asarray(worth(first.reshape(shape))).reshape(abc.shape[2:])[rows, cols].ravel()
+    best, where = _refine(coarse, lambda ref, degrees, sel: _values_at(part, slides, ref, degrees, sel, weights),
+                          mask)
     out, angle = np.zeros(abc.shape[2:]), np.zeros(abc.shape[2:])
     out[rows, cols], angle[rows, cols] = best.reshape(part.shape[2:]), where.reshape(part.shape[2:])
     return CriticalPlane(out.reshape(shape), angle.reshape(shape))
@@ -198,35 +217,65 @@ def _reach(m: int) -> int:
 
 def _coarse_field(abc: np.ndarray, slides: dict, weights: np.ndarray) -> np.ndarray:
     """SWT on each plane of ``weights`` (:func:`_weights`) at every point: (point, plane), the points (row, x) in
-    order.  A few rows at a time, each state's normal stresses and strains on every plane are one matrix product,
-    and a sliding state's window is a running extreme of them along x (log₂ m comparisons a point)."""
+    order.  A few rows at a time, each state's normal stresses and strains on every plane are a matrix product laid
+    (x, row, plane), and a sliding state's window is a running extreme of them along x (:func:`_run_along`, over
+    whole contiguous slabs), all in arrays made once: fresh ones, mapped and faulted in at every step, made the
+    windows 5x as slow."""
     _, states, nrows, nx = abc.shape
     planes = weights.shape[0] // 2
+    w_s, w_e = np.ascontiguousarray(weights[:planes].T), np.ascontiguousarray(weights[planes:].T)  # (3, planes)
+    group = min(nrows, max(1, CHUNK_2D // (2 * planes * nx)))
     out = np.empty((nrows, nx, planes))
-    group = max(1, CHUNK_2D // (2 * planes * nx))
+    buffers: dict = {}
     for lo in range(0, nrows, group):
-        hi = min(nrows, lo + group)
-        top = high = low = None
+        g = min(nrows - lo, group)
+        if g not in buffers:  # (at most two sizes: the groups and the last)
+            buffers[g] = [np.empty((nx, g, planes), dtype=abc.dtype) for _ in range(10)]
+        sn, en, s_top, e_high, e_low, top, high, low, *work = buffers[g]
         for t in range(states):
-            v = (weights @ abc[:, t, lo:hi].reshape(3, -1)).reshape(2 * planes, hi - lo, nx)
-            if t in slides:  # (the largest over the window for the stresses and strains at once, the least for
-                m = _reach(slides[t])  # the strains)
-                v, e_low = _window(v, m, np.maximum), _window(v[planes:], m, np.minimum)
+            block = np.ascontiguousarray(abc[:, t, lo:lo + g].transpose(2, 1, 0)).reshape(-1, 3)  # (x·row, 3)
+            np.matmul(block, w_s, out=sn.reshape(-1, planes))
+            np.matmul(block, w_e, out=en.reshape(-1, planes))
+            if t in slides:
+                m = _reach(slides[t])
+                s_hi = _run_along(sn, m, np.maximum, s_top, work)
+                e_hi, e_lo = _run_along(en, m, np.maximum, e_high, work), _run_along(en, m, np.minimum, e_low, work)
             else:
-                e_low = v[planes:]
-            s_top, e_high = v[:planes], v[planes:]
-            if top is None:
-                top, high, low = s_top.copy(), e_high.copy(), e_low.copy()
+                s_hi, e_hi, e_lo = sn, en, en
+            if t == 0:
+                np.copyto(top, s_hi), np.copyto(high, e_hi), np.copyto(low, e_lo)
             else:
-                np.maximum(top, s_top, out=top)
-                np.maximum(high, e_high, out=high)
-                np.minimum(low, e_low, out=low)
+                np.maximum(top, s_hi, out=top)
+                np.maximum(high, e_hi, out=high)
+                np.minimum(low, e_lo, out=low)
         np.maximum(top, 0.0, out=top)
         high -= low
         high *= 0.5
         top *= high
-        out[lo:hi] = top.transpose(1, 2, 0)
+        out[lo:lo + g] = top.transpose(1, 0, 2)
     return out.reshape(nrows * nx, planes)
+
+
+def _run_along(src: np.ndarray, m: int, pick, out: np.ndarray, work: list) -> np.ndarray:
+    """:func:`_window` along the first axis, into ``out``, with ``work`` two arrays of ``src``'s shape to build its
+    sparse table in."""
+    width = abs(m)
+    if width <= 1:
+        np.copyto(out, src)
+        return out
+    a, o = (src[::-1], out[::-1]) if m < 0 else (src, out)
+    n = a.shape[0]
+    run, span, length, k = a, 1, n, 0  # run[i]: the extreme of a[i : i + span], for i < length
+    while 2 * span <= width and span < n:
+        dst = work[k][::-1] if m < 0 else work[k]
+        pick(run[:length - span], run[span:length], out=dst[:length - span])
+        run, span, length, k = dst, 2 * span, length - span, 1 - k
+    body = max(0, n - width + 1)
+    if body:
+        pick(run[:body], run[width - span:width - span + body], out=o[:body])
+    if body < n:  # the last width − 1: each the extreme of what is left
+        o[body:] = pick.accumulate(a[body:][::-1], axis=0)[::-1]
+    return out
 
 
 def _values_at(abc: np.ndarray, slides: dict, ref: np.ndarray, degrees: np.ndarray, points: np.ndarray,
@@ -262,17 +311,18 @@ def _gathered_2d(abc: np.ndarray, slides: dict, points: np.ndarray) -> np.ndarra
     return np.concatenate(parts, axis=1)
 
 
-def _refine(coarse: np.ndarray, value) -> tuple:
+def _refine(coarse: np.ndarray, value, mask: Optional[np.ndarray] = None) -> tuple:
     """From the 5° pass's values (point, angle): each point's two best planes' neighbourhoods degree by degree,
     where the 5° value is at least FINE_SHARE of the peak (a fretting cycle's mirror-image planes often tie to
     round-off, and the pass about the wrong one of two near-equal peaks can miss the best by 10 % or more).
     ``value(ref, degrees, selection)`` → the SWT at the selected points on the planes ref·5° + degrees·1°
-    (degrees, selection)."""
+    (degrees, selection).  ``mask`` (point): where the second pass may be made at all."""
     step = np.pi / COARSE_ANGLES
     per = ANGLES // COARSE_ANGLES
     top = np.argmax(coarse, axis=1)
     best, where = coarse[np.arange(len(coarse)), top], top * step
-    sel = np.flatnonzero(best >= FINE_SHARE * best.max()) if best.size and best.max() > 0 else np.zeros(0, int)
+    sel = np.flatnonzero((best >= FINE_SHARE * best.max()) & (True if mask is None else mask)) if (
+        best.size and best.max() > 0) else np.zeros(0, int)
     top, rest = top[sel], coarse[sel]
     rest[np.arange(sel.size), top] = -np.inf
     second = np.argmax(rest, axis=1)
