@@ -519,18 +519,36 @@ def _window(a: np.ndarray, m: int, pick) -> np.ndarray:
 
 
 def _slid_bound(rows: np.ndarray, slides: dict, youngs: float, poisson: float) -> np.ndarray:
-    """:func:`bound_3d` over the states and every position their slides passed (rows (6, time, row, x))."""
-    sxx, syy, szz = rows[0], rows[1], rows[2]
-    axy, axz, ayz = np.abs(rows[3]), np.abs(rows[4]), np.abs(rows[5])
-    rx, ry, rz = axy + axz, axy + ayz, axz + ayz
-    upper = np.maximum(np.maximum(sxx + rx, syy + ry), szz + rz)
-    lower = np.minimum(np.minimum(sxx - rx, syy - ry), szz - rz)
-    trace = sxx + syy + szz
-    e_hi, e_lo = (1.0 + poisson) * upper - poisson * trace, (1.0 + poisson) * lower - poisson * trace
-    for k, m in slides.items():
-        upper[k], e_hi[k] = _window(upper[k], m, np.maximum), _window(e_hi[k], m, np.maximum)
-        e_lo[k] = _window(e_lo[k], m, np.minimum)
-    return np.maximum(upper.max(axis=0), 0.0) * 0.5 * (e_hi.max(axis=0) - e_lo.min(axis=0)) / youngs
+    """:func:`bound_3d` over the states and every position their slides passed (rows (6, time, row, x)): a state at
+    a time, in arrays made once (a state's field stays in the cache; the whole history's temporaries did not)."""
+    shape = rows.shape[2:]
+    top, high, low = np.full(shape, -np.inf), np.full(shape, -np.inf), np.full(shape, np.inf)
+    axy, axz, ayz, reach, upper, lower, trace, tmp = (np.empty(shape) for _ in range(8))
+    for t in range(rows.shape[1]):
+        s = rows[:, t]
+        np.abs(s[3], out=axy), np.abs(s[4], out=axz), np.abs(s[5], out=ayz)
+        for i, (p, q) in enumerate(((axy, axz), (axy, ayz), (axz, ayz))):  # Gershgorin's radius of each row
+            np.add(p, q, out=reach)
+            if i == 0:
+                np.add(s[0], reach, out=upper), np.subtract(s[0], reach, out=lower)
+            else:
+                np.maximum(upper, np.add(s[i], reach, out=tmp), out=upper)
+                np.minimum(lower, np.subtract(s[i], reach, out=tmp), out=lower)
+        np.add(s[0], s[1], out=trace)
+        trace += s[2]
+        trace *= poisson
+        upper_e = np.subtract((1.0 + poisson) * upper, trace, out=tmp)
+        lower_e = np.subtract(np.multiply(lower, 1.0 + poisson, out=lower), trace, out=lower)
+        s_hi = upper
+        if t in slides:
+            m = slides[t]
+            s_hi, upper_e, lower_e = (_window(upper, m, np.maximum), _window(upper_e, m, np.maximum),
+                                      _window(lower_e, m, np.minimum))
+        np.maximum(top, s_hi, out=top)
+        np.maximum(high, upper_e, out=high)
+        np.minimum(low, lower_e, out=low)
+    np.maximum(top, 0.0, out=top)
+    return top * 0.5 * (high - low) / youngs
 
 
 def _gathered(rows: np.ndarray, slides: dict, points: np.ndarray) -> np.ndarray:
@@ -550,33 +568,45 @@ def _gathered(rows: np.ndarray, slides: dict, points: np.ndarray) -> np.ndarray:
 def _coarse_rows(rows: np.ndarray, slides: dict, search: np.ndarray, normals: np.ndarray, youngs: float,
                  poisson: float) -> tuple:
     """The first pass over the rows holding searched points, a few rows at a time: each plane's normal stress and
-    strain per state, a slid state's over its window (:func:`_window`), their extremes over the history."""
+    strain per state (two matrix products, laid (x, row, plane): ε_n = ((1 + ν)σ_n − ν·tr σ)/E has weights of its
+    own), a slid state's over its window (:func:`_run_along`, in arrays made once), their extremes over the
+    history."""
     n, weights = _plane_weights(normals)
+    k = len(n)
     nx = rows.shape[-1]
     wanted = np.unique(search // nx)
-    group = max(1, CHUNK // (nx * len(n)))
+    group = max(1, CHUNK // (nx * k))
     value_at, where_at = np.zeros(rows.shape[2] * nx), np.zeros(rows.shape[2] * nx, dtype=int)
-    a, b = (1.0 + poisson) / youngs, poisson / youngs
+    w_s = np.ascontiguousarray(weights)  # (6, k)
+    w_e = (1.0 + poisson) / youngs * weights - poisson / youngs * np.array([1.0, 1, 1, 0, 0, 0])[:, None]
+    buffers: dict = {}
     for lo in range(0, wanted.size, group):
         r = wanted[lo:lo + group]
-        top = high = low = None
+        g = r.size
+        if g not in buffers:  # (at most two sizes: the groups and the last)
+            buffers[g] = [np.empty((nx, g, k)) for _ in range(10)]
+        sn, en, s_top, e_high, e_low, top, high, low, *work = buffers[g]
         for t in range(rows.shape[1]):
-            block = rows[:, t][:, r]  # (6, rows, x)
-            sn = (block.reshape(6, -1).T @ weights).reshape(r.size, nx, len(n))
-            en = a * sn - (b * (block[0] + block[1] + block[2]))[..., None]
-            s_top, e_high, e_low = sn, en, en
-            if t in slides:  # the window along x: move it to the last axis and back
+            block = np.ascontiguousarray(rows[:, t][:, r].transpose(2, 1, 0)).reshape(-1, 6)  # (x·row, 6)
+            np.matmul(block, w_s, out=sn.reshape(-1, k))
+            np.matmul(block, w_e, out=en.reshape(-1, k))
+            if t in slides:
                 m = slides[t]
-                s_top = np.moveaxis(_window(np.moveaxis(sn, 1, -1), m, np.maximum), -1, 1)
-                e_high = np.moveaxis(_window(np.moveaxis(en, 1, -1), m, np.maximum), -1, 1)
-                e_low = np.moveaxis(_window(np.moveaxis(en, 1, -1), m, np.minimum), -1, 1)
-            if top is None:
-                top, high, low = s_top.copy(), e_high.copy(), e_low.copy()
+                s_hi = _run_along(sn, m, np.maximum, s_top, work)
+                e_hi, e_lo = _run_along(en, m, np.maximum, e_high, work), _run_along(en, m, np.minimum, e_low, work)
             else:
-                np.maximum(top, s_top, out=top)
-                np.maximum(high, e_high, out=high)
-                np.minimum(low, e_low, out=low)
-        value = (np.maximum(top, 0.0) * 0.5 * (high - low)).reshape(-1, len(n))
+                s_hi, e_hi, e_lo = sn, en, en
+            if t == 0:
+                np.copyto(top, s_hi), np.copyto(high, e_hi), np.copyto(low, e_lo)
+            else:
+                np.maximum(top, s_hi, out=top)
+                np.maximum(high, e_hi, out=high)
+                np.minimum(low, e_lo, out=low)
+        np.maximum(top, 0.0, out=top)
+        high -= low
+        high *= 0.5
+        top *= high
+        value = top.transpose(1, 0, 2).reshape(-1, k)  # (row, x) in order
         flat = (r[:, None] * nx + np.arange(nx)[None, :]).ravel()
         where_at[flat] = np.argmax(value, axis=1)
         value_at[flat] = value[np.arange(value.shape[0]), where_at[flat]]
@@ -588,22 +618,39 @@ CHUNK = 40_000  # points × normals at a time: the work arrays stay in the cache
 
 def _cone(s: np.ndarray, centre: np.ndarray, youngs: float, poisson: float, half: float, count: int) -> tuple:
     """Each point's best over a count × count grid of normals within ``half`` radians of its own ``centre`` (the
-    centre itself among them, so a point never gets worse)."""
+    centre itself among them, so a point never gets worse).  Each point's stresses are turned into its own frame
+    (t₁, t₂, centre) first (a 6 × 6 product per point): the grid's normals are then the same (a, b, 1)/|…| in every
+    frame, and all points' normal stresses and strains are two shared matrix products (BLAS) — not a 6 × count²
+    product per point."""
     helper = np.where(np.abs(centre[:, 2:3]) < 0.9, [[0.0, 0.0, 1.0]], [[1.0, 0.0, 0.0]])
     t1 = np.cross(centre, helper)
     t1 /= np.sqrt((t1 * t1).sum(axis=1, keepdims=True))
     t2 = np.cross(centre, t1)
+    frame = np.stack([t1, t2, centre], axis=1)  # (point, 3, 3): rows t₁, t₂, centre
+    local = np.matmul(np.ascontiguousarray(s.transpose(2, 1, 0)), _turning(frame))  # (point, time, 6)
     a, b = np.meshgrid(np.linspace(-half, half, count), np.linspace(-half, half, count))
-    n = centre[:, None, :] + a.reshape(1, -1, 1) * t1[:, None, :] + b.reshape(1, -1, 1) * t2[:, None, :]
-    n /= np.sqrt((n * n).sum(axis=2, keepdims=True))  # (point, k, 3)
-    w = np.empty((n.shape[0], 6, n.shape[1]))  # (point, 6, k): σ_n = Σ_c σ_c·w_c, batched products per point
-    w[:, 0], w[:, 1], w[:, 2] = n[..., 0] ** 2, n[..., 1] ** 2, n[..., 2] ** 2
-    w[:, 3], w[:, 4], w[:, 5] = 2 * n[..., 0] * n[..., 1], 2 * n[..., 0] * n[..., 2], 2 * n[..., 1] * n[..., 2]
-    sn = np.matmul(np.ascontiguousarray(s.transpose(2, 1, 0)), w)  # (point, time, k)
-    trace = (s[0] + s[1] + s[2]).T[:, :, None]  # (point, time, 1)
-    en = ((1.0 + poisson) / youngs) * sn - (poisson / youngs) * trace
+    own = np.stack([a.ravel(), b.ravel(), np.ones(a.size)], axis=1)  # (k, 3) in each point's frame
+    own, w = _plane_weights(own)
+    w_e = (1.0 + poisson) / youngs * w - poisson / youngs * np.array([1.0, 1, 1, 0, 0, 0])[:, None]  # (tr σ kept)
+    points, times = local.shape[:2]
+    flat = local.reshape(-1, 6)
+    sn, en = (flat @ w).reshape(points, times, -1), (flat @ w_e).reshape(points, times, -1)
     value = np.maximum(sn.max(axis=1), 0.0) * 0.5 * (en.max(axis=1) - en.min(axis=1))
     value[:, (count * count) // 2] *= 1.0 + 1e-15  # (ties go to the centre: a flat optimum keeps its normal)
     k = np.argmax(value, axis=1)
     rows = np.arange(value.shape[0])
-    return value[rows, k], n[rows, k]
+    n = own[k, 0:1] * t1 + own[k, 1:2] * t2 + own[k, 2:3] * centre  # back in (x, y, z)
+    return value[rows, k], n / np.sqrt((n * n).sum(axis=1, keepdims=True))
+
+
+_PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))  # the six components' indices, in _components' order
+
+
+def _turning(frame: np.ndarray) -> np.ndarray:
+    """(point, 6, 6): the weights that turn a point's six stress components into those in its ``frame`` (rows: the
+    new axes in x, y, z), σ' = σ @ W — σ'_ab = Σ R_ak·R_bl·σ_kl, each shear counted both ways."""
+    out = np.empty((frame.shape[0], 6, 6))
+    for j, (a, b) in enumerate(_PAIRS):
+        for i, (k, l) in enumerate(_PAIRS):
+            out[:, i, j] = frame[:, a, k] * frame[:, b, l] + (frame[:, a, l] * frame[:, b, k] if k != l else 0.0)
+    return out
