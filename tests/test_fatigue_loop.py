@@ -410,3 +410,39 @@ def test_with_a_wear_limit_and_the_crack_limit_the_first_crossing_is_the_limit_r
     out = run(load_case(TI, SHORT + ["limits={crack_initiation: true, max_wear_depth_stationary: 0.16 um}"])).summary
     assert out["limit_reached"] == "crack_initiation" and out["damage_mode"] == "cracking"
     assert out["cycles_to_limit"] == out["cycles_to_crack_initiation"]
+
+
+@pytest.mark.parametrize("nx", [1, 5, 6, 11, 20, 40])
+@pytest.mark.parametrize("width", [2, 7, 8, 9, 16, 33, 64, 70])
+@pytest.mark.parametrize("sign", [1, -1])
+def test_the_running_extremes_along_x_equal_a_loop_for_windows_longer_than_the_grid(nx, width, sign):
+    """_run_along (the 5° pass's windows, laid (x, row, plane)) against the extremes taken one by one, the positions
+    beyond the grid left out: also where the window is longer than the grid (a long slide on a short field)."""
+    import fretsim.fatigue.swt as swt
+    rng = np.random.default_rng(nx * 100 + width)
+    src = rng.normal(size=(nx, 3, 4))
+    for pick in (np.maximum, np.minimum):
+        out, work = np.full_like(src, np.nan), [np.full_like(src, np.nan), np.full_like(src, np.nan)]
+        got = swt._run_along(src, sign * width, pick, out, work)
+        want = np.array([pick.reduce(src[[j for j in range(x, x + sign * width, sign) if 0 <= j < nx]], axis=0)
+                         for x in range(nx)])
+        assert np.array_equal(got, want)
+
+
+def test_a_slide_longer_than_the_grid_counts_as_one_to_the_grids_end():
+    """A slide over more elements than the field has columns (2D: m ≥ nx − 1; 3D: |m| ≥ nx) passes every position
+    to the grid's end, held there: the same critical planes as the slide cut to the grid (it raised in the 5° pass's
+    running extremes instead)."""
+    from fretsim.fatigue.swt import swt_search_3d
+    rng = np.random.default_rng(4)
+    hist = tuple(rng.normal(scale=100.0, size=(4, 3, 6)) for _ in range(3))
+    for m in (8, 15, 40):
+        for sign in (1, -1):
+            long = swt_search(hist, 115000.0, 0.3, {1: sign * m, 3: -sign * m})
+            cut = swt_search(hist, 115000.0, 0.3, {1: sign * 5, 3: -sign * 5})
+            assert np.allclose(long.swt, cut.swt, rtol=1e-12, atol=0) and np.array_equal(long.angle, cut.angle)
+    s = rng.normal(scale=100.0, size=(6, 3, 2, 9))
+    for m in (16, 25):
+        long = swt_search_3d(s, 200000.0, 0.3, slides={1: m, 2: -m})
+        cut = swt_search_3d(s, 200000.0, 0.3, slides={1: 9, 2: -9})
+        assert np.allclose(long.swt, cut.swt, rtol=1e-12, atol=0) and np.allclose(long.normal, cut.normal, atol=1e-12)

@@ -266,7 +266,9 @@ def _run_along(src: np.ndarray, m: int, pick, out: np.ndarray, work: list) -> np
     a, o = (src[::-1], out[::-1]) if m < 0 else (src, out)
     n = a.shape[0]
     run, span, length, k = a, 1, n, 0  # run[i]: the extreme of a[i : i + span], for i < length
-    while 2 * span <= width and span < n:
+    # (a window longer than the axis needs no table: every position is in the tail below — and a span past the
+    # table's length would pair slices of different lengths)
+    while 2 * span <= min(width, n):
         dst = work[k][::-1] if m < 0 else work[k]
         pick(run[:length - span], run[span:length], out=dst[:length - span])
         run, span, length, k = dst, 2 * span, length - span, 1 - k
@@ -507,7 +509,7 @@ def _window(a: np.ndarray, m: int, pick) -> np.ndarray:
     src = a[..., ::-1] if m < 0 else a
     n = src.shape[-1]
     run, span = src, 1  # run[..., i]: the extreme of src[..., i : i + span]
-    while 2 * span <= width and span < n:
+    while 2 * span <= min(width, n):  # (as _run_along's: no table where no window lies wholly inside)
         run, span = pick(run[..., :-span], run[..., span:]), 2 * span
     out = np.empty(src.shape, dtype=np.result_type(src))
     body = max(0, n - width + 1)  # the positions whose whole window lies inside
