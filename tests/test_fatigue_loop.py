@@ -446,3 +446,16 @@ def test_a_slide_longer_than_the_grid_counts_as_one_to_the_grids_end():
         long = swt_search_3d(s, 200000.0, 0.3, slides={1: m, 2: -m})
         cut = swt_search_3d(s, 200000.0, 0.3, slides={1: 9, 2: -9})
         assert np.allclose(long.swt, cut.swt, rtol=1e-12, atol=0) and np.allclose(long.normal, cut.normal, atol=1e-12)
+
+
+def test_lives_of_infinite_and_undefined_values_are_the_scalar_ones_without_a_warning():
+    """inf (above any curve: a quarter of a reversal), nan, 0, negative: as :meth:`Basquin.life`, and no
+    RuntimeWarning (Newton's step on an infinite target was inf − inf)."""
+    import warnings
+    curve = Basquin(2030.0, -0.104, 0.841, -0.688, 115000.0, endurance_limit=0.5)
+    swt = np.array([np.inf, np.nan, -np.inf, 0.0, -3.0, 1e300, 3.0])
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        lives = curve.lives(swt)
+    want = [curve.life(float(s)) for s in swt]
+    assert [v for v in lives[:-1]] == want[:-1] and lives[-1] == pytest.approx(want[-1], rel=1e-10)

@@ -70,6 +70,8 @@ class Basquin:
         floor = max(self.swt(longest), self.endurance_limit if self.endurance_limit is not None else 0.0)
         out = np.full(swt.shape, np.inf)
         live = swt > floor
+        out[live & (swt >= self.swt(0.25))] = 0.25  # (above the curve's top, inf too: no root to find)
+        live &= swt < self.swt(0.25)
         if not live.any():
             return out
         target = swt[live]
@@ -85,7 +87,7 @@ class Basquin:
             if not (np.abs(step) > 1e-15 * np.maximum(1.0, np.abs(u))).any():
                 break
         lives = np.minimum(0.5 * np.exp(u), longest)
-        out[live] = np.where(target >= self.swt(0.25), 0.25, np.maximum(lives, 0.25))
+        out[live] = np.maximum(lives, 0.25)
         return out
 
     def _swt_array(self, cycles: np.ndarray) -> np.ndarray:
