@@ -49,6 +49,14 @@ class FatigueSpec:
     keep_stresses: bool = False  # output.stresses
     body: str = "stationary"  # whose: the flat's (the tractions at ξ + s) or the moving body's (−q at its points)
 
+    def line_layers(self) -> int:
+        """The layers a state between recorded states computes: every layer without a critical distance, else
+        those :func:`damage_parameter` reads (the surface layer standing for z = 0, the field interpolated at L)."""
+        if self.critical_distance is None:
+            return len(self.depths)
+        z = np.concatenate([[0.0], self.depths[1:]])
+        return min(len(z), int(np.searchsorted(z, self.critical_distance)) + 1)
+
 
 def fatigue_states(last: int, snapshots: tuple) -> tuple:
     """0, the recorded states, STATES_PER_DECADE per decade up to ``last`` and LINEAR_STATES evenly over it."""
@@ -119,7 +127,7 @@ def evaluate(spec: FatigueSpec, x: np.ndarray, dx: float, youngs: float, cyc, fu
     cols = history.window(p_on)
     z = spec.depths
     nz, nx = len(z), len(x)
-    layers = nz if full or spec.critical_distance is None else min(nz, int(np.searchsorted(z, spec.critical_distance)) + 1)
+    layers = nz if full else spec.line_layers()
     swt, angle = np.zeros((nz, nx)), np.zeros((nz, nx))
     if cols.stop <= cols.start:
         return _state(spec, z, x, swt, angle, None, 0.0 if full else math.nan, 0.0, 0.0, 0.0, full)

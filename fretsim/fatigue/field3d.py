@@ -56,7 +56,7 @@ def fields_3d(spec, x: np.ndarray, dx: float, dy: float, youngs: float, traction
     p_flat, q_flat = flat(p), flat(q)
     z = spec.depths
     nz = len(z)
-    layers = nz if full or spec.critical_distance is None else min(nz, int(np.searchsorted(z, spec.critical_distance)) + 1)
+    layers = nz if full else spec.line_layers()
     swt, angle, azimuth = np.zeros((nz, ny, nx)), np.zeros((nz, ny, nx)), np.zeros((nz, ny, nx))
     rows, cols = _window(p_flat)
     if cols.stop <= cols.start:
