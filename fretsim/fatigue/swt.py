@@ -227,35 +227,48 @@ def _coarse_field(abc: np.ndarray, slides: dict, weights: np.ndarray) -> np.ndar
     planes = weights.shape[0] // 2
     w_s, w_e = np.ascontiguousarray(weights[:planes].T), np.ascontiguousarray(weights[planes:].T)  # (3, planes)
     group = min(nrows, max(1, CHUNK_2D // (2 * planes * nx)))
+    windows = {t: _reach(m) for t, m in slides.items()}
     out = np.empty((nrows, nx, planes))
     buffers: dict = {}
     for lo in range(0, nrows, group):
         g = min(nrows - lo, group)
         if g not in buffers:  # (at most two sizes: the groups and the last)
             buffers[g] = [np.empty((nx, g, planes), dtype=abc.dtype) for _ in range(10)]
-        sn, en, s_top, e_high, e_low, top, high, low, *work = buffers[g]
-        for t in range(states):
-            block = np.ascontiguousarray(abc[:, t, lo:lo + g].transpose(2, 1, 0)).reshape(-1, 3)  # (x·row, 3)
-            np.matmul(block, w_s, out=sn.reshape(-1, planes))
-            np.matmul(block, w_e, out=en.reshape(-1, planes))
-            if t in slides:
-                m = _reach(slides[t])
-                s_hi = _run_along(sn, m, np.maximum, s_top, work)
-                e_hi, e_lo = _run_along(en, m, np.maximum, e_high, work), _run_along(en, m, np.minimum, e_low, work)
-            else:
-                s_hi, e_hi, e_lo = sn, en, en
-            if t == 0:
-                np.copyto(top, s_hi), np.copyto(high, e_hi), np.copyto(low, e_lo)
-            else:
-                np.maximum(top, s_hi, out=top)
-                np.maximum(high, e_hi, out=high)
-                np.minimum(low, e_lo, out=low)
-        np.maximum(top, 0.0, out=top)
-        high -= low
-        high *= 0.5
-        top *= high
+        top = _planes_pass(lambda t: np.ascontiguousarray(abc[:, t, lo:lo + g].transpose(2, 1, 0)).reshape(-1, 3),
+                           states, windows, w_s, w_e, buffers[g])  # (each state's (x·row, 3))
         out[lo:lo + g] = top.transpose(1, 0, 2)
     return out.reshape(nrows * nx, planes)
+
+
+def _planes_pass(block_of, states: int, windows: dict, w_s: np.ndarray, w_e: np.ndarray, bufs: list) -> np.ndarray:
+    """SWT on every plane of the weights at a group of points laid (x, row, plane), from each state's stress
+    components ``block_of(t)`` (x·row, components): the state's normal stresses and strains are two products into
+    ``bufs`` (ten arrays of the group's shape), a slid state's (``windows`` {t: :func:`_window`'s count}) taken over
+    its window (:func:`_run_along`), and their extremes kept in place.  Returns one of ``bufs``, overwritten by the
+    next call."""
+    sn, en, s_top, e_high, e_low, top, high, low, *work = bufs
+    k = sn.shape[-1]
+    for t in range(states):
+        block = block_of(t)
+        np.matmul(block, w_s, out=sn.reshape(-1, k))
+        np.matmul(block, w_e, out=en.reshape(-1, k))
+        if t in windows:
+            m = windows[t]
+            s_hi = _run_along(sn, m, np.maximum, s_top, work)
+            e_hi, e_lo = _run_along(en, m, np.maximum, e_high, work), _run_along(en, m, np.minimum, e_low, work)
+        else:
+            s_hi, e_hi, e_lo = sn, en, en
+        if t == 0:
+            np.copyto(top, s_hi), np.copyto(high, e_hi), np.copyto(low, e_lo)
+        else:
+            np.maximum(top, s_hi, out=top)
+            np.maximum(high, e_hi, out=high)
+            np.minimum(low, e_lo, out=low)
+    np.maximum(top, 0.0, out=top)
+    high -= low
+    high *= 0.5
+    top *= high
+    return top
 
 
 def _run_along(src: np.ndarray, m: int, pick, out: np.ndarray, work: list) -> np.ndarray:
@@ -589,27 +602,8 @@ def _coarse_rows(rows: np.ndarray, slides: dict, search: np.ndarray, normals: np
         g = r.size
         if g not in buffers:  # (at most two sizes: the groups and the last)
             buffers[g] = [np.empty((nx, g, k)) for _ in range(10)]
-        sn, en, s_top, e_high, e_low, top, high, low, *work = buffers[g]
-        for t in range(rows.shape[1]):
-            block = np.ascontiguousarray(rows[:, t][:, r].transpose(2, 1, 0)).reshape(-1, 6)  # (x·row, 6)
-            np.matmul(block, w_s, out=sn.reshape(-1, k))
-            np.matmul(block, w_e, out=en.reshape(-1, k))
-            if t in slides:
-                m = slides[t]
-                s_hi = _run_along(sn, m, np.maximum, s_top, work)
-                e_hi, e_lo = _run_along(en, m, np.maximum, e_high, work), _run_along(en, m, np.minimum, e_low, work)
-            else:
-                s_hi, e_hi, e_lo = sn, en, en
-            if t == 0:
-                np.copyto(top, s_hi), np.copyto(high, e_hi), np.copyto(low, e_lo)
-            else:
-                np.maximum(top, s_hi, out=top)
-                np.maximum(high, e_hi, out=high)
-                np.minimum(low, e_lo, out=low)
-        np.maximum(top, 0.0, out=top)
-        high -= low
-        high *= 0.5
-        top *= high
+        top = _planes_pass(lambda t: np.ascontiguousarray(rows[:, t][:, r].transpose(2, 1, 0)).reshape(-1, 6),
+                           rows.shape[1], slides, w_s, w_e, buffers[g])  # (each state's (x·row, 6))
         value = top.transpose(1, 0, 2).reshape(-1, k)  # (row, x) in order
         flat = (r[:, None] * nx + np.arange(nx)[None, :]).ravel()
         where_at[flat] = np.argmax(value, axis=1)
