@@ -242,3 +242,32 @@ def test_a_3d_fatigue_run_whose_grid_is_widened_matches_one_on_the_wide_grid_fro
     assert out.summary["swt_max_MPa"] == pytest.approx(wide.summary["swt_max_MPa"], rel=1e-5)
     for key in ("swt_location_x_mm", "swt_location_y_mm", "swt_depth_um"):
         assert out.summary[key] == pytest.approx(wide.summary[key], abs=1e-12), key
+
+
+def test_the_largest_shear_taken_where_j2_allows_it_equals_the_eigenvalues_everywhere():
+    """_largest_shear reads Tresca's stress only where J₂ is at least 3/4 of its largest (no other point can hold
+    the peak: (σ₁ − σ₃)/2 lies between 1.5 and √3 times √(J₂/3)): the same value and depth as numpy's eigenvalues
+    at every point, on random histories and on one whose peak sits where J₂ is not largest."""
+    from fretsim.fatigue.field3d import _largest_shear
+    rng = np.random.default_rng(7)
+    pairs = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))
+
+    def brute(st):
+        m = np.zeros(st.shape[1:] + (3, 3))
+        for c, (i, j) in enumerate(pairs):
+            m[..., i, j] = m[..., j, i] = st[c]
+        e = np.linalg.eigvalsh(m)
+        shear = ((e[..., 2] - e[..., 0]) / 2).max(axis=0)
+        k = np.unravel_index(np.argmax(shear), shear.shape)
+        return shear[k], k[0]
+
+    for _ in range(50):
+        st = rng.standard_normal((6, 3, 5, 4, 6)) * rng.uniform(0.1, 100.0)
+        value, layer = _largest_shear(st)
+        want, want_layer = brute(st)
+        assert value == pytest.approx(want, rel=1e-12) and layer == want_layer
+    # pure shear (τ = √3 r) at one point against a uniaxial state (τ = 1.5 r) of larger J₂ at another
+    st = np.zeros((6, 1, 2, 1, 1))
+    st[3, 0, 0] = 1.0  # τxy = 1: J₂ = 1, Tresca 1
+    st[0, 0, 1] = 1.9  # σxx = 1.9: J₂ = 1.9²/3 = 1.20, Tresca 0.95
+    assert _largest_shear(st) == (pytest.approx(1.0, rel=1e-12), 0)
