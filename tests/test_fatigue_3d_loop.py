@@ -62,6 +62,32 @@ def test_the_3d_plane_search_finds_a_dense_searchs_planes_and_the_bound_holds():
     assert np.abs(between[top] / dense[top] - 1).max() < 2e-3
 
 
+def test_the_first_passs_single_precision_leaves_each_standing_value_within_a_part_in_a_million_of_double():
+    """The 3D first pass runs in single precision; a point the cones do not refine keeps its value: that value is
+    its own normal's SWT in double to 1e-6 of the field's peak (single precision's 6e-8 of the stresses' and
+    strains' scale; relative to a small value itself up to 5e-5 here, where its strain range is a small difference
+    of large strains), and the refined points are double throughout (the cones evaluate their centre again)."""
+    from fretsim.fatigue.swt import REFINE_SHARE_3D, _plane_values
+    x, dx, p, q = _sphere_states()
+    st = stress_history(p, q, dx, dx, np.array([0.002, 0.02, 0.05, 0.1]), NU)
+    flat = st.reshape(6, 3, -1)
+    found = swt_search_3d(flat, E, NU, skip=0.01, full=False)
+    value, normal = found.swt.ravel(), found.normal.reshape(-1, 3)
+    standing = np.flatnonzero((value > 0) & (value < REFINE_SHARE_3D * value.max()))
+    assert standing.size > 50
+    again = np.array([_plane_values(flat[:, :, [i]], np.stack(_weights_of(normal[i]))[:, None], E, NU)[0, 0]
+                      for i in standing])
+    assert np.abs(value[standing] - again).max() < 1e-6 * value.max()
+    refined = np.flatnonzero(value >= REFINE_SHARE_3D * value.max())
+    again = np.array([_plane_values(flat[:, :, [i]], np.stack(_weights_of(normal[i]))[:, None], E, NU)[0, 0]
+                      for i in refined])
+    assert np.abs(value[refined] / again - 1).max() < 1e-12
+
+
+def _weights_of(n):
+    return (n[0] ** 2, n[1] ** 2, n[2] ** 2, 2 * n[0] * n[1], 2 * n[0] * n[2], 2 * n[1] * n[2])
+
+
 def test_the_plane_angles_give_back_the_normal_up_to_its_sign():
     n = hemisphere_normals(50) * np.where(np.arange(50) % 2, 1, -1)[:, None]
     theta, beta = plane_angles(n)
