@@ -163,9 +163,10 @@ def swt_search(history: tuple, youngs: float, poisson: float, slides: Optional[d
     nx = shape[-1]
     abc = np.stack([0.5 * (sxx + szz), 0.5 * (sxx - szz), sxz]).reshape(3, sxx.shape[0], -1, nx)  # (3, state, row, x)
     slides = {k: m for k, m in (slides or {}).items() if m}
+    windows = {t: _reach(m) for t, m in slides.items()}  # (the positions each slide passed, as _window counts them)
     rows, cols = slice(None), slice(None)
     if skip > 0:  # the bounding box of the points worth searching (with the windows' reach along x)
-        bound = _bound(abc, slides, youngs, poisson)
+        bound = _bound(abc, windows, youngs, poisson)
         on = bound >= skip * bound.max() if bound.size and bound.max() > 0 else np.zeros(bound.shape, bool)
         if not on.any():
             return CriticalPlane(np.zeros(shape), np.zeros(shape))
@@ -174,14 +175,14 @@ def swt_search(history: tuple, youngs: float, poisson: float, slides: Optional[d
         rows = slice(int(r[0]), int(r[-1]) + 1)
         cols = slice(max(0, int(c[0]) - reach), int(c[-1]) + reach + 1)
     part = np.ascontiguousarray(abc[:, :, rows, cols])
-    coarse = _coarse_field(part, slides, _weights(np.arange(COARSE_ANGLES) * (180 // COARSE_ANGLES), youngs, poisson))
+    coarse = _coarse_field(part, windows, _weights(np.arange(COARSE_ANGLES) * (180 // COARSE_ANGLES), youngs, poisson))
     weights = lambda degrees: _weights(degrees, youngs, poisson)  # noqa: E731
     mask = None
     if worth is not None:
         first = np.zeros(abc.shape[2:])
         first[rows, cols] = coarse.max(axis=1).reshape(part.shape[2:])
         mask = np.asarray(worth(first.reshape(shape))).reshape(abc.shape[2:])[rows, cols].ravel()
-    best, where = _refine(coarse, lambda ref, degrees, sel: _values_at(part, slides, ref, degrees, sel, weights),
+    best, where = _refine(coarse, lambda ref, degrees, sel: _values_at(part, windows, ref, degrees, sel, weights),
                           mask)
     out, angle = np.zeros(abc.shape[2:]), np.zeros(abc.shape[2:])
     out[rows, cols], angle[rows, cols] = best.reshape(part.shape[2:]), where.reshape(part.shape[2:])
@@ -199,15 +200,15 @@ def _weights(degrees, youngs: float, poisson: float) -> np.ndarray:
                                                                         axis=1)])
 
 
-def _bound(abc: np.ndarray, slides: dict, youngs: float, poisson: float) -> np.ndarray:
+def _bound(abc: np.ndarray, windows: dict, youngs: float, poisson: float) -> np.ndarray:
     """max σ₁·(max ε₁ − min ε₃)/2 over the history at each point (row, x): no plane's SWT exceeds it."""
     r = np.hypot(abc[1], abc[2])
     k, mean = (1.0 + poisson) / youngs, (1.0 - 2.0 * poisson) * abc[0]
     parts = [(abc[0] + r, np.maximum), (k * (mean + r), np.maximum), (k * (mean - r), np.minimum)]
     out = []
     for v, pick in parts:
-        for t, m in slides.items():
-            v[t] = _window(v[t], _reach(m), pick)
+        for t, m in windows.items():
+            v[t] = _window(v[t], m, pick)
         out.append(v.max(axis=0) if pick is np.maximum else v.min(axis=0))
     return np.maximum(out[0], 0.0) * 0.5 * (out[1] - out[2])
 
@@ -217,7 +218,7 @@ def _reach(m: int) -> int:
     return m + (1 if m > 0 else -1)
 
 
-def _coarse_field(abc: np.ndarray, slides: dict, weights: np.ndarray) -> np.ndarray:
+def _coarse_field(abc: np.ndarray, windows: dict, weights: np.ndarray) -> np.ndarray:
     """SWT on each plane of ``weights`` (:func:`_weights`) at every point: (point, plane), the points (row, x) in
     order.  A few rows at a time, each state's normal stresses and strains on every plane are a matrix product laid
     (x, row, plane), and a sliding state's window is a running extreme of them along x (:func:`_run_along`, over
@@ -227,7 +228,6 @@ def _coarse_field(abc: np.ndarray, slides: dict, weights: np.ndarray) -> np.ndar
     planes = weights.shape[0] // 2
     w_s, w_e = np.ascontiguousarray(weights[:planes].T), np.ascontiguousarray(weights[planes:].T)  # (3, planes)
     group = min(nrows, max(1, CHUNK_2D // (2 * planes * nx)))
-    windows = {t: _reach(m) for t, m in slides.items()}
     out = np.empty((nrows, nx, planes))
     buffers: dict = {}
     for lo in range(0, nrows, group):
@@ -295,11 +295,11 @@ def _run_along(src: np.ndarray, m: int, pick, out: np.ndarray, work: list) -> np
     return out
 
 
-def _values_at(abc: np.ndarray, slides: dict, ref: np.ndarray, degrees: np.ndarray, points: np.ndarray,
+def _values_at(abc: np.ndarray, windows: dict, ref: np.ndarray, degrees: np.ndarray, points: np.ndarray,
                weights) -> np.ndarray:
     """SWT at the flat indices ``points`` (row, x) on the planes ``ref``·5° + ``degrees``·1° (each point its own
     ``ref``: its (b, c) turned by 2·ref·5° so that the planes' weights are the same for all): (degrees, points)."""
-    hist = _gathered_2d(abc, slides, points)  # (3, history, point)
+    hist = _gathered(abc, windows, points)  # (3, history, point)
     phi = ref * (2.0 * np.pi / COARSE_ANGLES)  # 2φ of each point's reference plane
     c, s = np.cos(phi), np.sin(phi)
     turned = np.stack([hist[0], hist[1] * c + hist[2] * s, hist[2] * c - hist[1] * s])
@@ -313,19 +313,6 @@ def _values_at(abc: np.ndarray, slides: dict, ref: np.ndarray, degrees: np.ndarr
         out[:, lo:lo + size] = np.maximum(v[:planes].max(axis=1), 0.0) * 0.5 * (
             v[planes:].max(axis=1) - v[planes:].min(axis=1))
     return out
-
-
-def _gathered_2d(abc: np.ndarray, slides: dict, points: np.ndarray) -> np.ndarray:
-    """The histories (3, history, point) at the flat indices ``points`` (row, x): the states, then each sliding
-    state's window (its values 1 … |m| elements on, held at the grid's ends: a repeat changes no extreme)."""
-    nx = abc.shape[-1]
-    r, x = np.divmod(points, nx)
-    flat = abc.reshape(3, abc.shape[1], -1)
-    parts = [flat[:, :, points]]
-    for k, m in slides.items():
-        at = np.clip(x[None, :] + np.sign(m) * np.arange(1, abs(m) + 1)[:, None], 0, nx - 1)
-        parts.append(flat[:, k][:, r * nx + at])
-    return np.concatenate(parts, axis=1)
 
 
 def _refine(coarse: np.ndarray, value, mask: Optional[np.ndarray] = None) -> tuple:
@@ -569,8 +556,9 @@ def _slid_bound(rows: np.ndarray, slides: dict, youngs: float, poisson: float) -
 
 
 def _gathered(rows: np.ndarray, slides: dict, points: np.ndarray) -> np.ndarray:
-    """The histories (6, time, point) of the flat indices ``points``: the states, then each slide's positions on
-    the way (a position beyond the row repeats the last one inside: an extreme over a set is not changed by a
+    """The histories (components, time, point) of the flat indices ``points`` (rows (components, time, row, x): 3D's
+    six stresses, 2D's (a, b, c)): the states, then each slide's positions on the way, 1 … |m| − 1 (:func:`_window`'s
+    count; a position beyond the row repeats the last one inside: an extreme over a set is not changed by a
     repeat)."""
     nx = rows.shape[-1]
     r, x = np.divmod(points, nx)
