@@ -109,13 +109,21 @@ def test_for_symmetric_tractions_without_travel_the_moving_bodys_field_is_the_fl
     assert np.median(gap[strong]) < 1e-9
 
 
-def test_identical_bodies_in_the_loop_see_nearly_the_same_swt_mirrored():
+def test_identical_bodies_in_the_loop_see_nearly_the_same_swt_mirrored(tmp_path):
     """The Ti case's identical bodies, unworn: the flat's tractions move ±5 µm with the travel on a 240 µm
     contact, the moving body's do not, so the two bodies' SWT peaks agree within a few per cent, at mirrored x,
-    and their surface tension to 1 %."""
-    s = run(load_case(TI, ["loading.cycles=0", "grid.error_estimate=none", MOVING])).summary
+    and their surface tension to 1 %.  The loop is symmetric (q ↦ −q over x ↦ −x), so each body's field is
+    symmetric in x to round-off and its peak stands at both edges: which one the summary names is round-off's
+    choice (it changed with the tangential solves' rounding), so the fields' symmetry is checked and the
+    location compared in magnitude."""
+    from fretsim.api import read_results
+    s = run(load_case(TI, ["loading.cycles=0", "grid.error_estimate=none", MOVING]), tmp_path / "r.h5").summary
     assert s["swt_max_moving_MPa"] == pytest.approx(s["swt_max_MPa"], rel=0.03)
-    assert s["swt_location_x_moving_mm"] == pytest.approx(-s["swt_location_x_mm"], abs=0.01)
+    fields = read_results(tmp_path / "r.h5").subsurface
+    for key in ("swt", "swt_moving"):
+        f = np.asarray(fields[key])[-1]
+        assert np.abs(f - f[:, ::-1]).max() < 1e-9 * f.max()  # (so the peak at −x is the peak at +x)
+    assert abs(s["swt_location_x_moving_mm"]) == pytest.approx(abs(s["swt_location_x_mm"]), abs=0.01)
     assert s["max_surface_tensile_stress_moving_MPa"] == pytest.approx(s["max_surface_tensile_stress_MPa"],
                                                                        rel=0.01)
 

@@ -134,6 +134,63 @@ def test_tangential_solver_agrees_with_a_dense_bounded_least_squares_solution():
     assert np.all(res.slip[slipping] * res.traction[slipping] >= 0)
 
 
+@pytest.mark.parametrize("contact", ["ball", "cylinder"])
+@pytest.mark.parametrize("factor", [0.4, 0.9, 1.5, 8.0])  # of the gross-slip stroke: partial slip to gross slip
+def test_a_cycle_at_fixed_pressure_from_its_first_loading_is_the_cycle_solved_increment_by_increment(contact, factor):
+    """masing() builds every increment of a cycle at fixed pressure from the first loading alone (Masing's rule):
+    q_turn ∓ 2·q₀(o/2).  Against the tangential solver driven increment by increment round the same path (the
+    recorded loop's, sides finely cut; and the unrecorded one, a half-stroke per increment): the same traction,
+    travel and stick set after every increment, to the solver's tolerance.  A rule without the factor 2, or a
+    half-stroke that did not start from its turning point's state, is off by the traction itself."""
+    from fretsim.cycle.coulomb import gross_slip_stroke, increment_path, masing
+    from fretsim.cycle.loop import elastic_side, loop_path
+    grid, c, k, normal, a = ball_contact(24) if contact == "ball" else cylinder_contact(60)
+    mu = 0.6
+    p, _ = normal(np.zeros(grid.shape), None)
+    stroke = factor * gross_slip_stroke(k, p, mu)
+    member = fretting_cycle(grid, c, k, stroke, 185.0, mu)
+    for path in (loop_path(stroke, elastic_side(k, mu, p), 12), increment_path(stroke, 1)):
+        built = masing(member, p, path)
+        q = np.zeros(grid.shape)
+        for (u0, u1, _), (q_b, ds_b, stuck_b, _) in zip(path, built):
+            q, ds, stuck, _ = member._tangential(q, p, u1 - u0)
+            assert np.abs(q_b - q).max() < 1e-7 * mu * p.max()
+            assert np.abs(ds_b - ds).max() < 1e-7 * stroke
+            on = p > 0
+            # the same stick set, but for ties: an element at the bound |q| = μp that moves by nothing (round-off)
+            # both sticks and slides; the solver calls it stuck
+            tie = (np.abs(np.abs(q) - mu * p) < 1e-9 * mu * p.max()) & (np.abs(ds) < 1e-12 * stroke)
+            assert np.array_equal((stuck_b & on) | tie, (stuck & on) | tie)
+        if factor < 1.0:  # partial slip: something stuck at the end of each half-stroke
+            assert built[-1][2][p > 0].any()
+
+
+@pytest.mark.parametrize("factor", [0.5, 1.2, 3.0])  # of 2δ_t after a reversal: partly stuck, just past, far past
+def test_an_increment_that_slides_the_whole_contact_is_taken_without_a_solve_and_is_the_solvers_answer(factor):
+    """_tangential takes q = ±μp without the solver where that leaves no point slipping against its traction (the
+    minimum is unique, so it is the increment's solution).  Against the solver on the same increment, from the
+    traction at the turning point: the same traction and travel where it slides; where part of the contact must
+    stick (below 2δ_t) the candidate must be refused and the solver's stick zone returned."""
+    grid, c, k, normal, a = ball_contact(24)
+    mu = 0.6
+    member = fretting_cycle(grid, c, k, 1e-3, 185.0, mu)
+    p, _ = normal(np.zeros(grid.shape), None)
+    q_turn = -mu * p  # the whole contact slid the other way up to the reversal
+    du = factor * 2.0 * M.ball_gross_slip_displacement(mu, 185.0, a, BODIES)
+    q, ds, stuck, its = member._tangential(q_turn, p, du)
+    on = p > 0
+    ref = solve_tangential(k, k(q_turn) + du, mu * p, q_turn, tol=1e-13)
+    assert ref.success, ref.message
+    assert np.abs(q - ref.traction).max() < 1e-8 * mu * p.max()
+    assert np.abs(ds[on] - np.where(ref.stick, 0.0, ref.slip)[on]).max() < 1e-8 * du
+    if factor < 1.0:
+        assert ref.stick.any() and stuck.any() and its > 0
+    elif not ref.stick.any():  # (just past 2δ_t the grid's last points may still hold: then the solver decides)
+        assert its == 0 and not stuck.any() and np.array_equal(q, mu * p)
+    if factor > 2.0:
+        assert its == 0
+
+
 # --- Mindlin: the ball (3D) -------------------------------------------------------------------------------------
 
 @pytest.mark.parametrize("fraction", [0.3, 0.7])

@@ -16,6 +16,10 @@ then −δ → +δ → −δ (the loop that is recorded and wears).  At each inc
   wear along its own travel over the flat (:func:`fretsim.wear.sweep_deposit`), which with equal travel
   everywhere is exactly the paper's stroke average.
 
+With the pressure fixed (mid-stroke), the whole cycle follows from its first loading by Masing's rule
+(:func:`masing`): one loading curve, not a solve per increment round the loop.  An increment that slides the whole
+contact at ±μp is recognised as such and taken without the tangential solver (:meth:`CoulombCycle._tangential`).
+
 The resolved stroke's increments are solved together where they can be (:mod:`fretsim.cycle.resolved`): all
 positions' normal contacts as the layers of one stack, the travels of increments that slide entirely at ±μp at
 once — the same discretisation to the same travel tolerance, at a quarter of the time in 2D; one by one in partial
@@ -181,8 +185,7 @@ class CoulombCycle:
         fixed = None
         if not self.resolved:
             seen = gap_wear(wear_moving, wear_stationary, self.grid.dx, self.stroke, self.gap_model)
-            if correction is not None:
-                seen = seen + correction
+            seen = seen if correction is None else seen + correction
             fixed = normal(seen, guess, extra, load=self.load, cycle=cycle)
         tally = _Tally(shape, self.grid.area * self.volume_factor)
         q, s = np.zeros(shape), np.zeros(shape)
@@ -194,6 +197,7 @@ class CoulombCycle:
         first, mid, end = _marks(path)
         pre = positions(self, wear_moving, wear_stationary, normal, np.array([b - a for a, b, _ in path]), guess,
                         extra, cycle, correction, predicted) if self.resolved else None
+        steps = masing(self, fixed[0], path) if fixed is not None and not self.rigid else None
         p_prev, ds_prev, du_prev = guess, None, None
         visits = []  # an implicit resolved step's (pressure, travel) at each increment, for its mismatch
         states = [] if detail else None  # the tractions round the loop (fretting fatigue; any pass may be returned)
@@ -214,7 +218,8 @@ class CoulombCycle:
                 if corrected:
                     visits.append((p, s, s + ds))
             else:
-                (p, res), (q_new, ds, stuck, its) = fixed, self._tangential(q, fixed[0], du)
+                (p, res), (q_new, ds, stuck, its) = fixed, steps[k] if steps is not None else \
+                    self._tangential(q, fixed[0], du)
                 tally.iterations += its
             if counted and pre is None:
                 tally.add(self, p, q_new, s, ds, abs(du) / (4.0 * self.stroke))
@@ -236,7 +241,7 @@ class CoulombCycle:
         defect, mismatch = 0.0, None
         if step:
             ahead = mismatch_rows(tally, self, stacks[3], *stacks[:3], step, w_lin) if stacks else None
-            defect, mismatch = self._defect(wear_moving, wear_stationary, step, w_lin, tally, p_mid, travel_mid,
+            defect, mismatch = _defect(self, wear_moving, wear_stationary, step, w_lin, tally, p_mid, travel_mid,
                                             correction[mid] if self.resolved and correction is not None else
                                             correction, None if ahead is None else ahead[mid])
             if self.resolved and corrected:
@@ -285,21 +290,6 @@ class CoulombCycle:
                 tally.iterations += res.iterations + its
         return p, res, q_new, ds, stuck
 
-    def _defect(self, wear_moving, wear_stationary, step: float, w_lin, tally: "_Tally", p_mid, travel_mid,
-                correction, mismatch=None) -> tuple[float, np.ndarray]:
-        """An implicit step's linearisation error: the gap growth the mid-stroke solve anticipated against what the
-        cycle found for that position (``mismatch``, unless given), and its effect on the deepest element's wear
-        (``defect``)."""
-        dx, shape = self.grid.dx, self.grid.shape
-        if mismatch is None:
-            found = tally.rate_m + (sweep_read(tally.rate_s, *travel_mid, dx, self.kernel) if self.resolved else
-                                    gap_wear(np.zeros(shape), tally.rate_s, dx, self.stroke, self.gap_model))
-            mismatch = step * (found - w_lin(p_mid))
-        deepest = np.unravel_index(np.argmax(wear_moving + wear_stationary), shape)
-        defect = abs(float(_response(self.compliance, step, w_lin, mismatch - (correction if correction is not None else 0))
-                           [deepest]))
-        return defect, mismatch
-
     def _tangential(self, q, p, du):
         """One increment's traction, its travel (the slip where in contact) and stick set; rigid bodies (``slip:
         uniform``) slide with the rig.
@@ -314,6 +304,13 @@ class CoulombCycle:
             return np.where(on, np.sign(du) * self.friction_coefficient * p, 0.0), np.full(p.shape, du), \
                 np.zeros(p.shape, bool), 0
         rhs = self.tangential(q) + du  # on the whole grid: the old traction may reach beyond the new contact
+        if du != 0.0:
+            # the whole contact sliding the rig's way at μp is the increment's solution (the minimum is unique)
+            # where it leaves no point slipping against its traction: one convolution, not a solve
+            cand = np.sign(du) * self.friction_coefficient * np.where(on, p, 0.0)
+            ds = rhs - self.tangential(cand)
+            if (np.sign(du) * ds[on] >= 0.0).all():
+                return cand, ds, np.zeros(p.shape, bool), 0
         rows, cols = _span(on.any(axis=1)), _span(on.any(axis=0))
         res = solve_tangential(self.tangential.window(rows, cols), rhs[rows, cols],
                                self.friction_coefficient * p[rows, cols], q[rows, cols], tol=self.tolerance)
@@ -395,6 +392,59 @@ def increment_path(stroke: float, n: int) -> list[tuple[float, float, bool]]:
     up = [(-d + 2 * d * k / n, -d + 2 * d * (k + 1) / n, True) for k in range(n)]
     down = [(d - 2 * d * k / n, d - 2 * d * (k + 1) / n, True) for k in range(n)]
     return quarter + up + down
+
+
+def masing(member: CoulombCycle, p: np.ndarray, path: list) -> list:
+    """(traction, travel, stick set, iterations) after each increment of ``path`` (0 → −δ, then half-strokes from
+    each turning point, as :func:`increment_path` and :func:`~fretsim.cycle.loop.loop_path` make them) under the
+    fixed pressure ``p``, from the first loading alone.
+
+    With the pressure fixed, the loop is Masing's (Mindlin–Deresiewicz; exact for the uncoupled, incremental
+    problem): from a turning point q_turn, after a rig travel o the traction is q_turn ∓ 2·q₀(o/2) and the travel
+    ∓2·t₀(o/2), where q₀(v), t₀(v) are the first loading's from rest to v.  (They satisfy Coulomb's conditions:
+    where q₀ sticks, 2·t₀ = 0 and |q| < μp; where it slides at μp, the reversed traction is at −μp and the travel
+    reversed.  The minimum being unique, it is the increment's solution.)  So one loading curve, sampled at half
+    of every offset the half-strokes reach, serves the quarter and both half-strokes: the tangential solves of a
+    recorded cycle's loop are halved, and a cycle in partial slip solves once, not three times."""
+    ups = [(a, b) for a, b, _ in path[1:]]
+    offsets = sorted({round(abs(b - (-member.stroke if b > a else member.stroke)), 15) for a, b in ups}
+                     | {2.0 * member.stroke})
+    q, t = np.zeros(p.shape), np.zeros(p.shape)
+    curve, v = {}, 0.0
+    for o in offsets:  # the first loading, monotone: each value from the last (the stick zone only shrinks)
+        q, ds, stuck, its = member._tangential(q, p, o / 2.0 - v)
+        t, v = t + ds, o / 2.0
+        curve[o] = (q, t, stuck, its)
+    q_m, t_m, stuck_m, _ = curve[2.0 * member.stroke]
+    out = [(-q_m, -t_m, stuck_m, sum(c[3] for c in curve.values()))]  # 0 → −δ: the first loading, the other way
+    #                                                                    (the curve's solves counted once, here)
+    q_turn, t_prev = -q_m, np.zeros(p.shape)
+    for a, b in ups:
+        sign = 1.0 if b > a else -1.0
+        turn = -sign * member.stroke
+        if a == turn:  # a half-stroke starts: from the state at its turning point
+            q_turn, t_prev = (out[-1][0], np.zeros(p.shape))
+        qo, to, stuck, _ = curve[round(abs(b - turn), 15)]
+        travel = sign * 2.0 * to
+        out.append((q_turn + sign * 2.0 * qo, travel - t_prev, stuck, 0))
+        t_prev = travel
+    return out
+
+
+def _defect(member: CoulombCycle, wear_moving, wear_stationary, step: float, w_lin, tally: "_Tally", p_mid, travel_mid,
+            correction, mismatch=None) -> tuple[float, np.ndarray]:
+    """An implicit step's linearisation error: the gap growth the mid-stroke solve anticipated against what the
+    cycle found for that position (``mismatch``, unless given), and its effect on the deepest element's wear
+    (``defect``)."""
+    dx, shape = member.grid.dx, member.grid.shape
+    if mismatch is None:
+        found = tally.rate_m + (sweep_read(tally.rate_s, *travel_mid, dx, member.kernel) if member.resolved else
+                                gap_wear(np.zeros(shape), tally.rate_s, dx, member.stroke, member.gap_model))
+        mismatch = step * (found - w_lin(p_mid))
+    deepest = np.unravel_index(np.argmax(wear_moving + wear_stationary), shape)
+    defect = abs(float(_response(member.compliance, step, w_lin, mismatch - (correction if correction is not None else 0))
+                       [deepest]))
+    return defect, mismatch
 
 
 def _response(compliance, step: float, w_lin, mismatch: np.ndarray) -> np.ndarray:
