@@ -165,6 +165,24 @@ def test_a_cycle_at_fixed_pressure_from_its_first_loading_is_the_cycle_solved_in
             assert built[-1][2][p > 0].any()
 
 
+def test_a_frictionless_cycle_at_fixed_pressure_slides_four_strokes_recorded_or_not():
+    """μ = 0 (a block may set it under coulomb slip): the elastic side is of no width, so the recorded loop's side
+    increments have none.  Each must move nothing: the recorded cycle slides every point 4δ and wears as the cycle
+    taken a half-stroke at a time (k·p·4δ), with no energy.  (An increment of no width read as the other
+    half-stroke's slid 6δ.)"""
+    grid, c, k, normal, a = cylinder_contact(80)
+    stroke = 0.025
+    member = fretting_cycle(grid, c, k, stroke, 18.5, 0.0)
+    zero = np.zeros(grid.shape)
+    recorded, plain = (member.solve(zero, zero, normal, None, detail=d) for d in (True, False))
+    p, on = recorded.pressure, recorded.pressure > 0
+    np.testing.assert_allclose(recorded.slip_moving[on], 4 * stroke, rtol=1e-12)
+    np.testing.assert_allclose(recorded.rate_moving, member.k_moving * 4 * stroke * p, rtol=1e-12, atol=0)
+    for key in ("rate_moving", "rate_stationary", "slip_moving"):
+        np.testing.assert_allclose(getattr(recorded, key), getattr(plain, key), rtol=1e-12, atol=0)
+    assert recorded.energy == 0.0 and recorded.work == pytest.approx(plain.work, rel=1e-12)
+
+
 @pytest.mark.parametrize("factor", [0.5, 1.2, 3.0])  # of 2δ_t after a reversal: partly stuck, just past, far past
 def test_an_increment_that_slides_the_whole_contact_is_taken_without_a_solve_and_is_the_solvers_answer(factor):
     """_tangential takes q = ±μp without the solver where that leaves no point slipping against its traction (the

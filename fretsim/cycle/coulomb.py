@@ -407,7 +407,9 @@ def masing(member: CoulombCycle, p: np.ndarray, path: list) -> list:
     of every offset the half-strokes reach, serves the quarter and both half-strokes: the tangential solves of a
     recorded cycle's loop are halved, and a cycle in partial slip solves once, not three times."""
     ups = [(a, b) for a, b, _ in path[1:]]
-    offsets = sorted({round(abs(b - (-member.stroke if b > a else member.stroke)), 15) for a, b in ups}
+    # (up and down half-strokes reach their offsets by the same floating operations, (o − δ) ± δ, so the exact
+    # values are the keys: no rounding, which loses the offsets' last digits where δ_t is tiny)
+    offsets = sorted({abs(b - (-member.stroke if b > a else member.stroke)) for a, b in ups if b != a}
                      | {2.0 * member.stroke})
     q, t = np.zeros(p.shape), np.zeros(p.shape)
     curve, v = {}, 0.0
@@ -420,11 +422,14 @@ def masing(member: CoulombCycle, p: np.ndarray, path: list) -> list:
     #                                                                    (the curve's solves counted once, here)
     q_turn, t_prev = -q_m, np.zeros(p.shape)
     for a, b in ups:
+        if b == a:  # an increment of no width (a side of none: μ = 0): nothing moves
+            out.append((out[-1][0], np.zeros(p.shape), out[-1][2], 0))
+            continue
         sign = 1.0 if b > a else -1.0
         turn = -sign * member.stroke
         if a == turn:  # a half-stroke starts: from the state at its turning point
             q_turn, t_prev = (out[-1][0], np.zeros(p.shape))
-        qo, to, stuck, _ = curve[round(abs(b - turn), 15)]
+        qo, to, stuck, _ = curve[abs(b - turn)]
         travel = sign * 2.0 * to
         out.append((q_turn + sign * 2.0 * qo, travel - t_prev, stuck, 0))
         t_prev = travel
