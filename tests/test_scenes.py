@@ -35,6 +35,35 @@ def _elliptical(n: int, rx=1.0, ry=3.0, load=5.0):
     return h, np.array([ax / h.ax - 1, ay / h.ay - 1, p.max() / h.peak_pressure - 1, res.approach / h.approach - 1])
 
 
+@pytest.mark.parametrize("ratio", [1.001, 1.5, 3.3, 40.0, 1e4])
+def test_the_elliptical_eccentricity_is_the_root_scipys_brentq_finds(ratio):
+    """hertz_elliptical bisects for e² (scipy.optimize stays unimported: 0.13 s of a point contact's start-up):
+    the axes from brentq's root of the same function to 1e-12, and the load they carry."""
+    import math
+    from scipy.optimize import brentq
+    from scipy.special import ellipe, ellipk
+
+    h = hertz_elliptical(100.0, 5.0 * ratio, 5.0, 1.15e5)
+    small, big = 1.0 / (2 * 5.0 * ratio), 1.0 / (2 * 5.0)
+    m = brentq(lambda m: (ellipe(m) / (1 - m) - ellipk(m)) / (ellipk(m) - ellipe(m)) - big / small, 1e-10,
+               1 - 1e-15, xtol=1e-16, rtol=1e-15, maxiter=500)
+    a = (3.0 * 100.0 * (ellipk(m) - ellipe(m)) / (2.0 * math.pi * 1.15e5 * m * small)) ** (1.0 / 3.0)
+    assert (h.ax, h.ay) == pytest.approx((a, math.sqrt(1.0 - m) * a), rel=1e-12)  # (a along the larger radius, x)
+    assert 2.0 / 3.0 * math.pi * h.ax * h.ay * h.peak_pressure == pytest.approx(100.0, rel=1e-12)
+
+
+def test_a_point_contacts_run_does_not_import_scipy_optimize(tmp_path):
+    import subprocess
+    import sys
+    code = ("import sys; from fretsim.api import load_case, run; "
+            "run(load_case(sys.argv[1], ['loading.cycles=10', 'grid.error_estimate=none']), sys.argv[2]); "
+            "print('scipy.optimize' in sys.modules)")
+    for case in ("ball_partial_slip.yaml", "seat_rail.yaml"):
+        out = subprocess.run([sys.executable, "-c", code, str(CASES / case), str(tmp_path / f"{case}.h5")],
+                             capture_output=True, text=True, check=True).stdout
+        assert out.split()[-1] == "False", (case, out)
+
+
 def test_crossed_cylinders_of_unequal_radii_converge_to_elliptical_hertz_at_second_order():
     errors = np.array([_elliptical(n)[1] for n in (48, 96, 192)])
     rates = np.log2(np.abs(errors[:-1]) / np.abs(errors[1:]))
