@@ -43,8 +43,10 @@ PROBE = ("import json, sys; from fretsim.api import load_case, run; "
 
 def loop_seconds(tree: str, case: str, overrides: list[str]) -> float:
     env = dict(os.environ, PYTHONPATH=tree)
+    # (cwd: `python -c` puts the working directory first on sys.path, ahead of PYTHONPATH, so run from this repo's
+    #  root both trees would import this one)
     out = subprocess.run([sys.executable, "-c", PROBE, case, *overrides], env=env, capture_output=True, text=True,
-                         check=True)
+                         check=True, cwd=tree)
     return float(json.loads(out.stdout.strip().splitlines()[-1]))
 
 
