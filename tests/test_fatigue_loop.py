@@ -474,3 +474,30 @@ def test_lives_of_infinite_and_undefined_values_are_the_scalar_ones_without_a_wa
         lives = curve.lives(swt)
     want = [curve.life(float(s)) for s in swt]
     assert [v for v in lives[:-1]] == want[:-1] and lives[-1] == pytest.approx(want[-1], rel=1e-10)
+
+
+@pytest.mark.parametrize("stroke", ["3 um", "25 um"])  # partial slip (δ_t 5.5 µm) and gross slip
+def test_a_recorded_state_at_fixed_pressure_takes_its_fatigue_states_loop_and_their_fields(stroke):
+    """At fixed pressure (mid-stroke) the elastic sides are Masing's branches between their ends, and the fatigue
+    states take a side in one increment (FATIGUE_SIDE_INCREMENTS).  A recorded state's cycle cuts them in 12 for
+    the loop's shape; its fatigue fields must be its fatigue states' — the same SWT field from the recorded
+    cycle as from the fatigue state's cycle, to the tangential solver's tolerance (the side's inner states,
+    evaluated, moved it by up to 1.3e-5 of its peak, which this would catch) — and the damage points' lives the
+    same."""
+    from fretsim.cycle.result import TRACTIONS
+    from fretsim.fatigue.damage import evaluate
+    from fretsim.plan import prepare
+    from fretsim.simulate import _Loop
+    setup = prepare(load_case(TI, ["loading.cycles=0", "grid.error_estimate=none", f"loading.stroke={stroke}"]))[0]
+    loop = _Loop(setup, (), None)
+    spec, g = setup.fatigue, setup.grid
+    fields = []
+    for detail in (True, TRACTIONS):
+        cyc = loop.cycle_at(0, None, detail=detail)
+        assert np.array_equal(cyc.tractions[0][0], cyc.tractions[0][-1])  # (the pressure fixed round the loop)
+        fields.append(evaluate(spec, g.x, g.dx, spec.curve.youngs_modulus, cyc, full=True))
+    recorded, state = fields
+    assert len(loop.cycle_at(0, None, detail=True).tractions[0]) > 2 * len(loop.cycle_at(0, None, detail=TRACTIONS)
+                                                                             .tractions[0]) - 2  # (else: no test)
+    assert np.abs(recorded.swt - state.swt).max() < 1e-8 * state.swt.max()
+    np.testing.assert_allclose(recorded.life, state.life, rtol=1e-8)
