@@ -7,11 +7,12 @@ Cases longer than 5 000 cycles run their first 5 000 (a service case's 10⁹ wou
 explicit schemes take minutes for 20 000 on the Kirk cases); the table is rewritten after each case, so a
 stopped study keeps what it ran.  Report, do not tune.
 
-    python scripts/study_resolved_stability.py [--quick] [--from CASE]
+    python scripts/study_resolved_stability.py [--quick] [--from CASE] [--schemes bdf2,implicit]
 
 Prints a table; writes scripts/out/resolved_stability.{txt,csv} (``--from CASE``: the cases from CASE on,
 alphabetically, into scripts/out/resolved_stability_from_CASE.{txt,csv}, so that a study stopped part-way is
-continued without running again what it ran).
+continued without running again what it ran).  ``--schemes``: only these (the implicit ones, say, after a change to
+the implicit step), into scripts/out/resolved_stability_SCHEMES.{txt,csv}.
 """
 from __future__ import annotations
 
@@ -43,11 +44,12 @@ def overrides(path: Path) -> list[str]:
     return sets
 
 
-def main(quick: bool = False, start: str = "") -> None:
+def main(quick: bool = False, start: str = "", schemes: tuple = ()) -> None:
     say = Report()
     rows = []
     paths = [p for p in sorted((ROOT / "cases").glob("*.yaml")) if p.stem >= start][: 3 if quick else None]
     name = f"resolved_stability_from_{start}" if start else "resolved_stability"
+    name += "_" + "_".join(schemes) if schemes else ""
     say(f"{'case':<24}{'scheme':<10}{'status':<12}{'s':>7}  message")
     for path in paths:
         try:
@@ -55,7 +57,7 @@ def main(quick: bool = False, start: str = "") -> None:
         except CaseError as exc:
             say(f"{path.stem:<24}{'-':<10}{'refused':<12}{0:>7.1f}  {str(exc).splitlines()[0][:110]}")
             continue
-        for scheme in SCHEMES:
+        for scheme in schemes or SCHEMES:
             sets = [*base, f"jumping.scheme={scheme}"]
             t = time.perf_counter()
             try:
@@ -87,4 +89,5 @@ def main(quick: bool = False, start: str = "") -> None:
 
 if __name__ == "__main__":
     args = sys.argv[1:]
-    main("--quick" in args, args[args.index("--from") + 1] if "--from" in args else "")
+    main("--quick" in args, args[args.index("--from") + 1] if "--from" in args else "",
+         tuple(args[args.index("--schemes") + 1].split(",")) if "--schemes" in args else ())

@@ -52,7 +52,7 @@ import numpy as np
 
 from fretsim.compliance import scaled
 from fretsim.cycle.loop import LOOP_SIDE_INCREMENTS, elastic_side, loop_path, turning_loop
-from fretsim.cycle.resolved import TRAVEL_TOLERANCE, add_rows, mismatch_rows, positions, sweep_of
+from fretsim.cycle.resolved import TRAVEL_TOLERANCE, add_rows, coupled_positions, mismatch_rows, positions, sweep_of
 from fretsim.cycle.result import TRACTIONS, Cycle, CycleError, CycleSpec, stick_half_width
 from fretsim.grid import Grid
 from fretsim.solvers.tangential import solve_tangential
@@ -65,14 +65,22 @@ CORRECTIONS = 1  # fixed-point corrections of an implicit step's gap for the wea
 SPREAD_TO_CORRECT = 0.1  # ... where the slip varies by more than this share of its largest (1 − mean/max): in gross
 #                         slip far above δ_t every point slides nearly alike, the linearisation is nearly exact
 #                         (McColl 185 N: 1e-5 without the correction) and the correction would cost 1.5× the time
-RESOLVED_CORRECTIONS = 3  # ... every step of the resolved stroke, where the linear operator (a bound, the same at every
+RESOLVED_CORRECTIONS = 3  # ... every step of the resolved stroke that cannot be solved coupled (COUPLED: partial
+#                           slip, a solver other than cg, refinement's coarse grid), where the linear operator (a bound, the same at every
 #                           position) is further from each position's real wear: each pass cuts the step's bias
 #                           about 5× (McColl 185 N 2D at 1 000 cycles, BDF2 against the run cycle by cycle: +1.9 %,
 #                           +0.26 %, +0.025 % after 0, 1, 3 from no correction; scripts/results/resolved_stepping.txt)
 # (a resolved step that stopped correcting once a pass moved the deepest wear by less than 1 % of model.accuracy of
 # its depth, with each step's corrections from none, was +0.25 % off the run cycle by cycle at 1 000 cycles against an
 # estimate of 0.17 %: every step corrects RESOLVED_CORRECTIONS times, +0.025 % against 0.031 %; tests/test_friction.py)
-RESOLVED_PASSES = 1 + RESOLVED_CORRECTIONS  # the cost estimate's passes per resolved implicit step
+COUPLED = False  # a resolved implicit step solves its positions coupled by the step's wear (resolved.coupled_positions):
+#                 built and tested, not the default — 2D McColl 185 N 5× the mid-stroke run instead of 10×, 3D 17×
+#                 instead of 23×, widths nearer the run cycle by cycle, but the tube in service (2D, μ 0.9,
+#                 bdf2 and implicit) grew a pressure checkerboard at cycle 2.3e8 where the corrected passes complete
+RESOLVED_PASSES = 1 + RESOLVED_CORRECTIONS  # the cost estimate's passes per resolved implicit step; a coupled step
+#                                             costs about as much over the run (its CG takes 2–4 times a pass's
+#                                             iterations, the run about 0.6 times the steps the estimate counts):
+#                                             McColl 185 N estimated 1.7 s (2D) and 58 s (3D), ran 1.3 s and 60 s
 FATIGUE_SIDE_INCREMENTS = 1  # each elastic side of a fatigue state's cycle (not recorded): the flat's stresses
 #                              over the side move between its ends (the damage with 1, 2 and 12 alike to 1e-11 at
 #                              4, 10 and 25 µm on cases/ti_fretting_fatigue.yaml)
@@ -173,14 +181,15 @@ class CoulombCycle:
         return cyc
 
     def _solve(self, wear_moving, wear_stationary, normal, guess, step: float = 0.0, memory=None,
-              cycle: int = 0, detail: bool = True, correction=None, corrected: bool = False, predicted=None) -> Cycle:
+              cycle: int = 0, detail: bool = True, correction=None, corrected: bool = False, predicted=None,
+              couple: bool = False) -> Optional[Cycle]:
         """One cycle.  With the pressure fixed (mid_stroke) a half-stroke is one monotone increment, which the
         tangential solve takes exactly whatever its length: unless ``detail`` asks for the loop's shape (a
         recorded state), each half-stroke is taken in one increment — the same wear, slips, energy and regime."""
         shape = self.grid.shape
         n = self.increments if detail or self.resolved else 1
-        slip_lin = float((memory or {}).get("slip_lin", 4.0 * self.stroke))
-        w_lin = scaled(self._w_unit, slip_lin / (4.0 * self.stroke)) if step else None
+        w_lin = scaled(self._w_unit, float((memory or {}).get("slip_lin", 4.0 * self.stroke)) / (4.0 * self.stroke)) \
+            if step else None
         extra = scaled(w_lin, step) if step else None
         fixed = None
         if not self.resolved:
@@ -189,14 +198,15 @@ class CoulombCycle:
             fixed = normal(seen, guess, extra, load=self.load, cycle=cycle)
         tally = _Tally(shape, self.grid.area * self.volume_factor)
         q, s = np.zeros(shape), np.zeros(shape)
-        fine = max(LOOP_SIDE_INCREMENTS, self.increments)  # model.increments asks for a finer loop, never coarser
-        if detail == TRACTIONS:  # a fatigue state, not recorded: the tractions need the sides' ends, not their shape
-            fine = FATIGUE_SIDE_INCREMENTS
-        path = (loop_path(self.stroke, self._elastic_side(fixed[0]), fine) if detail and not self.resolved
-                and not self.rigid else increment_path(self.stroke, n))
+        path = _path(self, detail, fixed, n)
         first, mid, end = _marks(path)
-        pre = positions(self, wear_moving, wear_stationary, normal, np.array([b - a for a, b, _ in path]), guess,
-                        extra, cycle, correction, predicted) if self.resolved else None
+        pre = None
+        if self.resolved:  # (None: the coupled step cannot be taken here, the step corrects pass by pass)
+            found = _positions(self, wear_moving, wear_stationary, normal, path, guess, extra, cycle, step, memory,
+                               correction, predicted, couple)
+            if found is None:
+                return None
+            pre, correction = found
         steps = masing(self, fixed[0], path) if fixed is not None and not self.rigid else None
         p_prev, ds_prev, du_prev = guess, None, None
         visits = []  # an implicit resolved step's (pressure, travel) at each increment, for its mismatch
@@ -236,16 +246,11 @@ class CoulombCycle:
             p_prev, ds_prev, du_prev = p, ds, du
         stacks = _stacked(self, tally, path, pre, wear_stationary) if self.resolved else None
         if self.resolved and detail is True and not self.rigid and not corrected:  # (a corrected pass draws no loop)
-            tally.loop_u, tally.loop_q = turning_loop(self.stroke, fine, self._tangential, self._elastic_side,
-                                                      (q_low, p_low), (q_high, p_high), tally.area)
-        defect, mismatch = 0.0, None
-        if step:
-            ahead = mismatch_rows(tally, self, stacks[3], *stacks[:3], step, w_lin) if stacks else None
-            defect, mismatch = _defect(self, wear_moving, wear_stationary, step, w_lin, tally, p_mid, travel_mid,
-                                            correction[mid] if self.resolved and correction is not None else
-                                            correction, None if ahead is None else ahead[mid])
-            if self.resolved and corrected:
-                mismatch = ahead or _mismatches(visits, tally, step, w_lin, self.grid.dx, self.kernel)
+            tally.loop_u, tally.loop_q = turning_loop(self.stroke, max(LOOP_SIDE_INCREMENTS, self.increments),
+                                                      self._tangential, self._elastic_side, (q_low, p_low),
+                                                      (q_high, p_high), tally.area)
+        defect, mismatch = _step_defect(self, wear_moving, wear_stationary, step, w_lin, tally, stacks, p_mid,
+                                        travel_mid, correction, mid, corrected, visits) if step else (0.0, None)
         cyc = tally.cycle(self, p_mid, res_mid, stick_end, defect, mismatch)
         if states:
             cyc.tractions = tuple(np.array(a) for a in zip(*states))
@@ -373,6 +378,30 @@ class _Tally:
             defect=defect, mismatch=mismatch, stick=stick_end if stick_end.any() else None)
 
 
+def _path(member: CoulombCycle, detail, fixed, n: int) -> list:
+    """The cycle's increments: a recorded cycle at fixed pressure with its elastic sides finely cut (the loop), else
+    ``n`` even increments a half-stroke."""
+    fine = max(LOOP_SIDE_INCREMENTS, member.increments)  # model.increments asks for a finer loop, never coarser
+    if detail == TRACTIONS:  # a fatigue state, not recorded: the tractions need the sides' ends, not their shape
+        fine = FATIGUE_SIDE_INCREMENTS
+    if detail and not member.resolved and not member.rigid:
+        return loop_path(member.stroke, member._elastic_side(fixed[0]), fine)
+    return increment_path(member.stroke, n)
+
+
+def _positions(member: CoulombCycle, wear_moving, wear_stationary, normal, path: list, guess, extra, cycle: int,
+               step: float, memory, correction, predicted, couple: bool):
+    """A resolved cycle's positions solved together and the gap correction each carries: coupled by an implicit
+    step's wear (``couple``; None where that cannot be done here), else as a pass ((None, correction) where the
+    cycle goes increment by increment)."""
+    du = np.array([b - a for a, b, _ in path])
+    if couple:
+        return coupled_positions(member, wear_moving, wear_stationary, normal, du, np.array([c for *_, c in path]),
+                                 guess, extra, cycle, step, (memory or {}).get("positions"))
+    return positions(member, wear_moving, wear_stationary, normal, du, guess, extra, cycle, correction,
+                     predicted), correction
+
+
 def _marks(path: list) -> tuple[int, int, int]:
     """The loop's first increment (after the quarter); the increment over U = 0 going up (centred on it for the
     resolved stroke's odd count); the up-stroke's end."""
@@ -436,6 +465,19 @@ def masing(member: CoulombCycle, p: np.ndarray, path: list) -> list:
     return out
 
 
+def _step_defect(member: CoulombCycle, wear_moving, wear_stationary, step: float, w_lin, tally: "_Tally", stacks,
+                 p_mid, travel_mid, correction, mid: int, corrected: bool, visits: list) -> tuple:
+    """An implicit pass's (defect, mismatch): the mismatch at mid-stroke, or for a resolved pass that a correction
+    follows (``corrected``) each increment's own."""
+    ahead = mismatch_rows(tally, member, stacks[3], *stacks[:3], step, w_lin) if stacks else None
+    defect, mismatch = _defect(member, wear_moving, wear_stationary, step, w_lin, tally, p_mid, travel_mid,
+                               correction[mid] if member.resolved and correction is not None else correction,
+                               None if ahead is None else ahead[mid])
+    if member.resolved and corrected:
+        mismatch = ahead or _mismatches(visits, tally, step, w_lin, member.grid.dx, member.kernel)
+    return defect, mismatch
+
+
 def _defect(member: CoulombCycle, wear_moving, wear_stationary, step: float, w_lin, tally: "_Tally", p_mid, travel_mid,
             correction, mismatch=None) -> tuple[float, np.ndarray]:
     """An implicit step's linearisation error: the gap growth the mid-stroke solve anticipated against what the
@@ -463,7 +505,8 @@ def _response(compliance, step: float, w_lin, mismatch: np.ndarray) -> np.ndarra
 
 def _resolved_step(member: CoulombCycle, wear_moving, wear_stationary, normal, guess, step: float, memory,
                    cycle: int, detail: bool) -> Cycle:
-    """A resolved implicit step: its increments' gaps corrected RESOLVED_CORRECTIONS times for the wear the cycle
+    """A resolved implicit step: its positions solved coupled by the step's wear (resolved.coupled_positions), or
+    where that cannot be done, its increments' gaps corrected RESOLVED_CORRECTIONS times for the wear the cycle
     really found, from no correction.
 
     Not from the last step's corrections scaled to this one (tried: 1.4 passes a step instead of 4): a correction
@@ -471,12 +514,17 @@ def _resolved_step(member: CoulombCycle, wear_moving, wear_stationary, normal, g
     gap that the wear then kept — McColl 185 N 2D peaked at 328 MPa at 6 000 cycles where the run cycle by cycle
     has 81 MPa, 1.4 GPa on a grid four times finer, its width 0.3 % narrow (scripts/results/bench_resolved.txt,
     fifth round)."""
-    cyc, correction = None, None
-    for _ in range(1 + RESOLVED_CORRECTIONS):
+    cyc = member._solve(wear_moving, wear_stationary, normal, guess, step, memory, cycle, detail, corrected=True,
+                        couple=True) if COUPLED else None
+    passes = 0 if cyc is not None else 1 + RESOLVED_CORRECTIONS
+    correction = None
+    for _ in range(passes):
         cyc = member._solve(wear_moving, wear_stationary, normal, guess if cyc is None else cyc.pressure, step,
                             memory, cycle, detail, correction=correction, corrected=True,
                             predicted=None if cyc is None else cyc.positions)
         correction = cyc.mismatch
+    if cyc.positions:  # the next step's coupled solve starts from these
+        cyc.memory["positions"] = cyc.positions[0]
     if detail is True and not member.rigid:  # the recorded loop, of the pass returned only (48 ms a 2D draw)
         u, q = turning_loop(member.stroke, max(LOOP_SIDE_INCREMENTS, member.increments), member._tangential,
                             member._elastic_side, *cyc.turns, member.grid.area * member.volume_factor)

@@ -18,6 +18,15 @@ one stack (where the stack is small enough to gain: STACK_LIMIT):
   went — the same rule the increment-by-increment cycle applies, on both ends of each travel.  Positions that
   do not settle in MAX_ROUNDS leave the cycle to be solved increment by increment.
 
+An implicit step (a cycle that anticipates s cycles of its own wear) solves the positions **coupled**
+(:func:`coupled_positions`): each position's gap at the step's end holds the wear the whole cycle deposits — the
+moving body's, the same for all, and the flat's, which every position deposits along its travel and reads along
+its own, each position's deposit by one slip — so the positions are one convex problem (:func:`fretsim.solvers.rows.solve_coupled`), preconditioned
+by the coupling's rank-two structure per Fourier mode (:class:`Coupling`).  Solved position by position with a
+bound for the wear operator, a step needed three corrected passes and still left each position's gap off by half
+the step's wear at the scar's turning edges (tests/test_coupled_step.py); coupled it needs none (4 %), and its
+steps are longer (McColl 185 N 2D: 54 steps, not 90).
+
 The tally, the implicit step's mismatches and everything the cycle returns are then the same sums, over the
 stack.  This is the same discretisation as the increment-by-increment cycle (the same positions, travels to the
 same tolerance); it is not bit-identical to it (tests/test_resolved_rows.py measures how close).
@@ -28,7 +37,7 @@ from typing import Optional
 
 import numpy as np
 
-from fretsim.wear import Sweep, sweep_read
+from fretsim.wear import Sweep, _hat_integral, sweep_read
 
 TRAVEL_TOLERANCE = 0.1  # of an element: a resolved increment is solved again where a point's predicted travel was off
 #                         by more (the pressure follows the worn flat on that scale)
@@ -41,6 +50,9 @@ STACK_LIMIT = 60_000  # elements of a whole stack (positions × grid) beyond whi
 #                      185 N 3D (19 × 27 × 263 = 135 000) took 97.9 s stacked against 87.5 s one by one (84 s with
 #                      the normal solves in chunks), where 2D (19 × 427) is 4.2× faster stacked and the ball in gross
 #                      slip (19 × 25 × 85 = 40 000) 1.5×
+COUPLED_LIMIT = 1_000_000  # elements of a whole stack beyond which an implicit step corrects pass by pass
+OWN_SLIP_PASSES = 3  # coupled solves again with each point's own slip lagged (Coupling.remainder), at most
+OWN_SLIP_TOLERANCE = 1e-3  # ... until what it adds moves by less than this share of the step's largest wear
 MAX_ROUNDS = 4  # normal solves of the stack before the cycle goes increment by increment (2 is usual: the second
 #                 re-solves the few positions whose travel the first pressure moved by more than the tolerance)
 
@@ -91,6 +103,16 @@ def starts(ds: np.ndarray) -> np.ndarray:
     return s
 
 
+def _went(member, p: np.ndarray, du: np.ndarray, a: np.ndarray, b: np.ndarray) -> tuple:
+    """Where the points went at the pressures ``p`` (tractions, travels, stick sets, iterations, starts) and which
+    positions' points went more than TRAVEL_TOLERANCE of an element from the travels (``a`` → ``b``) their
+    pressures were solved over, at either end."""
+    q, ds, stuck, its = travels(member, p, du)
+    s = starts(ds)
+    off = np.where(p > 0, np.maximum(np.abs(s - a), np.abs(s + ds - b)), 0.0).max(axis=(1, 2))
+    return q, ds, stuck, its, s, off > TRAVEL_TOLERANCE * member.grid.dx
+
+
 def positions(member, wear_moving, wear_stationary, normal, du: np.ndarray, guess, extra, cycle: int,
               correction=None, predicted=None):
     """Every increment of a resolved cycle solved together: (pressures, contact results, tractions, starts,
@@ -130,11 +152,8 @@ def positions(member, wear_moving, wear_stationary, normal, du: np.ndarray, gues
         for i, res in zip(np.flatnonzero(redo), got[1]):
             results[i] = res
             iterations += res.iterations
-        q, ds, stuck, its = travels(member, p, du)
+        q, ds, stuck, its, s, redo = _went(member, p, du, a, b)
         iterations += its
-        s = starts(ds)
-        off = np.where(p > 0, np.maximum(np.abs(s - a), np.abs(s + ds - b)), 0.0).max(axis=(1, 2))
-        redo = off > TRAVEL_TOLERANCE * member.grid.dx
         if not redo.any():
             return p, results, q, s, ds, stuck, iterations
         a, b = np.where(redo[:, None, None], s, a), np.where(redo[:, None, None], s + ds, b)
@@ -212,3 +231,173 @@ def add_rows(tally, member, sweep: StackSweep, p, q, ds, shares: np.ndarray) -> 
 def mismatch_rows(tally, member, sweep: StackSweep, p, s, ds, step: float, w_lin) -> list:
     """For a resolved step's next pass, each increment's own mismatch (as coulomb._mismatches), all at once."""
     return list(step * (tally.rate_m + _read(member, tally.rate_s, s, s + ds, sweep) - w_lin(p)))
+
+
+def coupled_positions(member, wear_moving, wear_stationary, normal, du: np.ndarray, counted: np.ndarray, guess,
+                      extra, cycle: int, step: float, start: Optional[np.ndarray] = None):
+    """An implicit step's resolved cycle with every position's gap at the step's end: each position solved over
+    the wear the whole cycle deposits in the step (the moving body's, and the flat's read along its travel), as
+    one problem (:meth:`fretsim.loop.rows.NormalSolve.coupled`) — so that the step needs no correction passes.
+    (positions' tuple, and each increment's gap correction the solution implies: what an implicit pass would
+    have been corrected by); None where it cannot be done (the caller corrects pass by pass).
+
+    At fixed travels the wear a cycle deposits is linear in the pressures, p_j·ω_j with ω_j = c|ds_j| (c the law's
+    sliding factor: the amount where each point slides), taken one value a position (:class:`Coupling`), and what
+    position k reads of it is the transpose of what it deposits (the hat kernel reads and receives by the same
+    weights), so Ω times the coupled operator is symmetric and positive; the travels then follow the pressures as
+    in :func:`positions`, and the pass's defect measures what the linearisation (each point's own slip, the
+    travels) missed.  ``start``: the last step's
+    pressures at every position."""
+    coupled = getattr(normal, "coupled", None)
+    m, shape = du.size, member.grid.shape
+    if coupled is None or not getattr(normal, "stacks", True) or guess is None or \
+            m * member.grid.size > COUPLED_LIMIT or not step:
+        return None
+    # from the last step's positions where there is one (the turning positions' contacts are a third narrower
+    # than mid-stroke's: from mid-stroke's pressure everywhere the coupled solve took 1.5 times the iterations)
+    p = start.copy() if start is not None and start.shape == (m,) + shape else np.repeat(guess[None], m, axis=0)
+    found = travels(member, p, du, budget=m // PARTIAL_SHARE)
+    if found is None:
+        return None
+    iterations = found[3]
+    a = starts(found[1])
+    b = a + found[1]
+    flat = np.broadcast_to(wear_stationary, (m,) + shape)
+    factor = member.law.gross_slip_factor(member.friction_coefficient)
+    idx, rest = np.flatnonzero(counted), np.flatnonzero(~counted)
+    k_m, k_s = member.k_moving, member.k_stationary
+    for _ in range(MAX_ROUNDS):
+        sweep = sweep_of(member, p, a, b - a, wear_stationary, counted)
+        seen = wear_moving + _read(member, flat, a, b, sweep)
+        couple = Coupling(member, sweep, factor * np.abs(b - a)[idx], (a[idx], b[idx]), step, extra, p[idx] > 0)
+        lag = np.zeros(p[idx].shape)
+        for _ in range(1 + OWN_SLIP_PASSES):  # each point's own slip, lagged (see Coupling)
+            got = coupled(seen[idx] + lag, p[idx], couple, extra, load=member.load, cycle=cycle)
+            if got is None:
+                return None
+            p[idx] = got[0]
+            iterations += sum(res.iterations for res in got[1])
+            lag, moved = couple.remainder(p[idx]), lag
+            if np.abs(lag - moved).max() <= OWN_SLIP_TOLERANCE * max(np.abs(couple(p[idx]) + extra(p[idx])).max(),
+                                                                    1e-300):
+                break
+        results = [None] * m
+        for i, res in zip(idx, got[1]):
+            results[i] = res
+        r_m, r_s = couple.rates(p[idx], own=True)
+        grown = step * (r_m + _read(member, r_s, a[rest], b[rest])) if rest.size else None
+        if rest.size:  # the uncounted quarter deposits nothing: it reads the step's wear, solved on C alone
+            got = normal.rows(seen[rest] + grown, p[rest], None, load=member.load, cycle=cycle)
+            if got is None:
+                return None
+            p[rest] = got[0]
+            for i, res in zip(rest, got[1]):
+                results[i] = res
+                iterations += res.iterations
+        q, ds, stuck, its, s, redo = _went(member, p, du, a, b)
+        iterations += its
+        if not redo.any():
+            correction = np.empty((m,) + shape)
+            correction[idx] = couple(p[idx]) + lag
+            if rest.size:
+                correction[rest] = grown - extra(p[rest])
+            return (p, results, q, s, ds, stuck, iterations), list(correction)
+        a, b = s, s + ds
+    return None
+
+
+class Coupling:
+    """A resolved implicit step's coupling of its counted positions (:func:`coupled_positions`): the wear the cycle
+    deposits in the step, read by every position, less what the layers' own operator C + s·W already has.
+
+    Its preconditioner inverts the coupled operator as if the contact covered the window: per Fourier mode ξ along
+    x the coupling is of rank two over the positions — the moving body's wear, the same for every position, and
+    the flat's, which position k reads shifted by its travel o_k (a phase e^{iξo_k}) — so C(ξ)I + s·UVᵀ inverts by
+    Woodbury with a 2 × 2 solve per mode.  With each layer's own inverse instead (C + s·W)⁻¹, the modes in which
+    the positions differ were taken as stiff as those they share, and the iterations grew with the step (to 90)."""
+
+    def __init__(self, member, sweep, weight, travel: tuple, step: float, extra, on=None):
+        self.sweep, self.step, self.extra = sweep, step, extra
+        self.k_m, self.k_s = member.k_moving, member.k_stationary
+        m = weight.shape[0]
+        # each position's c·|ds| as most of its points in contact (``on``) have it, one value a position: with
+        # each point's own the coupling is not symmetric (a point deposits by its slip and reads unweighted), and
+        # past a reversal, where a position's points slide 12–15 % less and unevenly, its symmetric part was
+        # indefinite on the contact.  With one ω_k a position, Ω·(C + s·M) is symmetric and positive (M = GΩ, G
+        # the read-deposit Gram operator): CG weights each layer's inner products by ω_k (layer_weights).  What
+        # the points' own slips change in the wear the cycle then tallies is the pass's defect.
+        on = np.ones(weight.shape, bool) if on is None else on
+        self.omega = np.array([float(np.median(w[o])) if o.any() else float(np.median(w)) for w, o in zip(weight, on)])
+        self.weight = np.broadcast_to(self.omega[:, None, None], weight.shape)
+        self.own = weight  # each point's own c·|ds|: what differs from ω_k is lagged (remainder), not left out —
+        #                    left out, it was an explicit part of the step's stiffness, and the tube in service
+        #                    (steps of 10⁶ cycles) grew a pressure checkerboard at cycle 2.3e8
+        self.layer_weights = self.omega
+        self.start, self.end = (np.median(x.reshape(m, -1), axis=1) for x in travel)
+        kernel = getattr(extra, "kernel", None)
+        self.diagonal = float(kernel.max()) if kernel is not None and np.count_nonzero(kernel) == 1 else None
+
+    def rates(self, pc, own: bool = False):
+        """The moving body's and the flat's wear per cycle from the counted positions' pressures ``pc``, each point
+        by its position's slip ω_k (``own``: by its own)."""
+        amount = (self.own if own else self.weight) * pc
+        return self.k_m * amount.sum(axis=0), self.k_s * self.sweep.deposit(amount).sum(axis=0)
+
+    def remainder(self, pc):
+        """What each point's own slip adds to the step's wear that its position's ω_k leaves out, as each position
+        reads it: a gap correction for the next coupled solve (a fixed point: the difference is small — the
+        first increment past a reversal's points slide unevenly — so it settles in a pass or two)."""
+        amount = (self.own - self.weight) * pc
+        r_m, r_s = self.k_m * amount.sum(axis=0), self.k_s * self.sweep.deposit(amount).sum(axis=0)
+        return self.step * (r_m + self.sweep.read(np.broadcast_to(r_s, pc.shape)))
+
+    def __call__(self, pc):
+        r_m, r_s = self.rates(pc)
+        own = self.diagonal * pc if self.diagonal is not None else self.extra(pc)
+        return self.step * (r_m + self.sweep.read(np.broadcast_to(r_s, pc.shape))) - own
+
+    def preconditioner(self, win, rows: slice, cols: slice):
+        """An approximate inverse of C + s·(coupling) on the window operator ``win`` (C + s·W there)."""
+        c_hat = win.hat - (self.diagonal if self.diagonal is not None else self.extra.window(rows, cols).hat)
+        c_hat = np.maximum(c_hat.real if np.iscomplexobj(c_hat) else c_hat, 1e-3 * float(np.abs(win.hat).max()))
+        lx = win.fft_shape[1]
+        xi = 2.0 * np.pi * np.arange(c_hat.shape[-1]) / (lx * win.grid.dx)
+        r = _read_symbol(xi, self.start, self.end, win.grid.dx)
+        w = self.omega[:, None]
+        s = self.step
+        g11 = c_hat + s * self.k_m * float(self.omega.sum())  # (the 2 × 2 system per mode: the same along y)
+        g12 = s * self.k_s * (w * r).sum(axis=0)
+        g21 = s * self.k_m * (w * r.conj()).sum(axis=0)
+        g22 = c_hat + s * self.k_s * (w * np.abs(r) ** 2).sum(axis=0)
+        det = g11 * g22 - g12 * g21
+        a11, a12, a21, a22 = s * self.k_m * g22 / det, -s * self.k_m * g12 / det, -s * self.k_s * g21 / det, \
+            s * self.k_s * g11 / det
+        wr = w * r.conj()
+        inv_c = 1.0 / c_hat
+
+        def apply(v):
+            vh = win.forward(v)  # (m, ly, modes)
+            # (einsum, not tensordot: tensordot hands this small product to a multithreaded BLAS, whose threads
+            #  woke for every call — 4-8 ms a call, 2.2x the whole 2D McColl 185 N run on two cores)
+            v1 = np.einsum("k,kyx->yx", self.omega, vh)
+            v2 = np.einsum("kx,kyx->yx", wr, vh)
+            vh -= (a11 * v1 + a12 * v2)[None]
+            vh -= r[:, None, :] * (a21 * v1 + a22 * v2)[None]
+            vh *= inv_c
+            return win.backward(vh)
+        return apply
+
+
+def _read_symbol(xi: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float) -> np.ndarray:
+    """The Fourier symbol (positions, modes) of reading the flat along a travel from ``start`` to ``end`` (mm), as
+    :func:`fretsim.wear.sweep_read` reads it with the hat kernel: Σ_j w_j·e^{iξ·j·dx} over the elements j the
+    travel reaches, w_j the hat (linear interpolation) of element j averaged over the travel."""
+    a, b = start / dx, end / dx
+    lo = np.floor(np.minimum(a, b)).astype(int) - 1
+    span = int(np.max(np.ceil(np.maximum(a, b)) - lo)) + 2
+    j = lo[:, None] + np.arange(span)[None]  # (m, span) elements
+    length = b - a
+    point = np.abs(length) < 1e-9
+    averaged = (_hat_integral(b[:, None] - j) - _hat_integral(a[:, None] - j)) / np.where(point, 1.0, length)[:, None]
+    w = np.where(point[:, None], np.clip(1.0 - np.abs(a[:, None] - j), 0.0, None), averaged)
+    return (w[..., None] * np.exp(1j * dx * j[..., None] * xi[None, None, :])).sum(axis=1)

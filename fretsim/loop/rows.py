@@ -14,7 +14,7 @@ import numpy as np
 from fretsim.compliance import add
 from fretsim.compliance.operator import Convolution
 from fretsim.loop import checks
-from fretsim.solvers.rows import solve_rows
+from fretsim.solvers.rows import solve_coupled, solve_rows
 
 
 class NormalSolve:
@@ -34,6 +34,32 @@ class NormalSolve:
         s = self.loop.s
         return s.coarse is None and s.method == "cg" and isinstance(s.compliance, Convolution)
 
+    def _operator(self, extra):
+        op = self.loop.s.compliance
+        if extra is not None:
+            if self._summed[0] is not extra or self._summed[1] is not op:
+                self._summed = (extra, op, add(op, extra))
+            op = self._summed[2]
+        return op if isinstance(op, Convolution) else None
+
+    def coupled(self, seen: np.ndarray, guess: np.ndarray, couple, extra=None, load: Optional[float] = None,
+                cycle: int = 0):
+        """(pressures, a ContactResult per layer) of the layers of ``seen`` solved as one problem whose gaps also
+        grow by ``couple(p)`` (:func:`fretsim.solvers.rows.solve_coupled`), every layer checked as a single solve
+        is; None where that cannot be done here or did not converge (the member then corrects pass by pass)."""
+        s = self.loop.s
+        op = self._operator(extra) if self.stacks else None
+        if op is None:
+            return None
+        found = solve_coupled(op, s.gap + seen, load, guess, s.tolerance, couple)
+        if found is None:
+            return None
+        for res in found:
+            checks.check_solution(res, op.grid.area, load, s.method, cycle, self.loop.n)
+        pressures = np.stack([res.pressure for res in found])
+        checks.check_edges(pressures.max(axis=0), s.band, s.grid, cycle, s.y_edges_free)
+        return pressures, found
+
     def rows(self, seen: np.ndarray, guess: np.ndarray, extra=None, load: Optional[float] = None, cycle: int = 0):
         """(pressures (m, My, Mx), a ContactResult per layer) for the gaps ε + ``seen`` (m, My, Mx), warm-started
         from ``guess`` (m, My, Mx); None where they cannot be solved together.  A row the stack did not settle is
@@ -42,12 +68,8 @@ class NormalSolve:
         s = loop.s
         if not self.stacks:
             return None
-        op = s.compliance
-        if extra is not None:
-            if self._summed[0] is not extra or self._summed[1] is not op:
-                self._summed = (extra, op, add(op, extra))
-            op = self._summed[2]
-        if not isinstance(op, Convolution):
+        op = self._operator(extra)
+        if op is None:
             return None
         found = solve_rows(op, s.gap + seen, load, guess, s.tolerance)
         pressures, results = np.zeros(seen.shape), []

@@ -177,3 +177,119 @@ def _complementary_rows(u, h, p, allowed) -> np.ndarray:
     scale = np.maximum(np.where(on, np.abs(u), 0.0).max(axis=A), 1e-300)
     worst = np.where(outside, g - alpha[:, None, None], np.inf).min(axis=A)
     return worst >= -PENETRATION * scale
+
+
+def solve_coupled(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float, couple) -> list:
+    """The contacts of the layers of ``gaps`` (m, My, Mx) solved as one problem, each layer carrying ``load``, where
+    each layer's gap also grows by ``couple(p)`` — a linear map of the whole stack (a resolved implicit step's
+    wear, which every position deposits and every position reads) such that Ω(C + couple) is symmetric and
+    positive on each layer's load-keeping changes, Ω the layers' weights ``couple.layer_weights`` (1 without).  The
+    stack minimises Σ_k ω_k(½p_kᵀC p_k + p_kᵀg_k) + ½pᵀΩ(couple p) over p ≥ 0 with each layer's Σp·A = W: one
+    convex problem, so Polonsky–Keer's iteration carries over with one step length for the stack and each layer's
+    load kept by its own mean gap (its approach).  On the window of the warm starts, verified on the whole grid as
+    :func:`solve_rows` verifies; ``couple`` acts on whole-grid stacks.  A ContactResult per layer, or None if the
+    stack did not converge or outgrew its window (the caller then solves it another way)."""
+    m, ny, nx = gaps.shape
+    on = p0 > 0
+    if not on.any(axis=A).all() or (np.isnan(gaps) | np.isneginf(gaps)).any():
+        return None
+    rows, cols = _span(on.any(axis=(0, 2)), ny), _span(on.any(axis=(0, 1)), nx)
+    whole = rows.stop - rows.start == ny and cols.stop - cols.start == nx
+    win = op if whole else op.window(rows, cols)
+
+    def couple_win(p):
+        full = np.zeros(gaps.shape)
+        full[:, rows, cols] = p
+        return couple(full)[:, rows, cols]
+
+    precond = couple.preconditioner(win, rows, cols) if hasattr(couple, "preconditioner") else _preconditioner(win)
+    found = cg_coupled(win, gaps[:, rows, cols], load, p0[:, rows, cols], tol, couple_win, precond,
+                       getattr(couple, "layer_weights", None))
+    if found is None:
+        return None
+    p = np.zeros(gaps.shape)
+    p[:, rows, cols] = found[0]
+    its, err = found[1], found[2]
+    u = op(p) + couple(p)  # the whole grid: nothing outside the window may penetrate
+    finite = np.isfinite(gaps)
+    on = p > 0
+    approach = ((u + np.where(finite, gaps, 0.0)) * on).sum(axis=A) / np.maximum(on.sum(axis=A), 1)
+    y = np.where(finite, u + gaps - approach[:, None, None], np.inf)
+    scale = np.maximum(np.where(on, np.abs(u), 0.0).max(axis=A), 1e-300)
+    inside = np.zeros((ny, nx), bool)
+    inside[rows, cols] = True
+    if (~inside & (y < -WINDOW_PENETRATION * scale[:, None, None])).any():
+        return None
+    worst = np.maximum(np.where(on, np.abs(y), 0.0).max(axis=A),
+                       np.where(~on & finite, np.clip(-y, 0.0, None), 0.0).max(axis=A))
+    spread = u.max(axis=A) - u.min(axis=A)
+    residual = worst / np.where(spread > 0, spread, 1.0)
+    return [ContactResult(p[k], float(approach[k]), on[k], its, True,
+                          f"cg converged in {its} iterations (relative pressure change {err:.1e} < {tol:.0e}, gap "
+                          f"complementary; coupled with {m - 1} other positions by the step's wear)",
+                          float(residual[k])) for k in range(m)]
+
+
+def cg_coupled(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float, couple, precond, layer_weights=None):
+    """Preconditioned constrained CG on the coupled stack (:func:`solve_coupled`): (pressures, iterations, last
+    relative change), or None where it did not converge.  :func:`cg_rows`'s iteration with the inner products,
+    the step and the conjugacy taken over the whole stack; ``precond`` approximates the coupled operator's
+    inverse.  ``layer_weights`` ω_k: the operator is symmetric in the inner product Σ_k ω_k⟨·,·⟩_k (a coupling
+    K = s·GΩ with G symmetric: Ω(C + K) is), which the iteration then uses."""
+    n = gaps[0].size
+    total = load / op.grid.area
+    allowed = np.isfinite(gaps)
+    h = np.where(allowed, gaps, 0.0)
+    max_iter = max(1000, 5 * int(np.sqrt(n)) + 200)
+    p = np.where(allowed, np.clip(p0, 0.0, None), 0.0)
+    if not (p.sum(axis=A) > 0).all():
+        return None
+    p *= (total / p.sum(axis=A))[:, None, None]
+    u, c = op(p), couple(p)
+    t = np.zeros_like(p)
+    lw = (np.ones(p.shape[0]) if layer_weights is None else np.asarray(layer_weights, float))[:, None, None]
+    gz_old, delta = 1.0, 0.0
+    for it in range(1, max_iter + 1):
+        mask = p > 0
+        w = mask.astype(float)
+        count = w.sum(axis=A)
+        g = u + c + h
+        g -= ((g * w).sum(axis=A) / count)[:, None, None]
+        z = precond(g * w) * w
+        z -= w * (z.sum(axis=A) / count)[:, None, None]
+        gz = float((lw * g * z).sum())
+        beta = delta * gz / gz_old if delta > 0 and gz_old != 0.0 else 0.0
+        t = (z + beta * t) * w
+        gz_old = gz
+        r_op, r_c = op(t), couple(t)
+        r = r_op + r_c
+        denom = float((lw * r * t).sum() - (lw[:, 0, 0] * (r * w).sum(axis=A) / count * t.sum(axis=A)).sum())
+        penetrating = ~mask & allowed & (g < 0.0)
+        pen = penetrating.any(axis=A)
+        p_old = p
+        if denom <= 0.0 or gz == 0.0:
+            if not pen.any():  # converged only where the gap is also level over the contact: with a coupling
+                #                 whose symmetric part is not positive, denom <= 0 is a direction of negative
+                #                 curvature, not the minimum (the solver then said "converged" with a residual of 0.67)
+                scale = np.maximum(np.where(mask, np.abs(u + c), 0.0).max(axis=A), 1e-300)
+                level = (np.abs(g * w).max(axis=A) <= PENETRATION * scale).all()
+                return (p, it, 0.0) if level and _complementary_rows(u + c, h, p, allowed).all() else None
+            p = p.copy()
+            for k in np.flatnonzero(pen):
+                p[k] = _admit(p_old[k], g[k], penetrating[k], total)
+            u, c, delta = op(p), couple(p), 0.0
+            continue
+        tau = float((lw * g * t).sum()) / denom
+        p, clipped, scale = _steps(p_old, np.full(p.shape[0], tau), t, g, penetrating, total)
+        delta = 0.0 if pen.any() else 1.0  # (a restart where elements enter: without, 1.7 times the iterations)
+        if clipped.any() or pen.any() or np.abs(scale - 1.0).max() > 1e-12 or it % RECOMPUTE_EVERY == 0:
+            u, c = op(p), couple(p)
+        else:  # (the step kept every layer's load: a layer's rescaling, which the coupling mixes, would not)
+            u = u - tau * r_op
+            c = c - tau * r_c
+        change = float((np.abs(p - p_old).sum(axis=A) / total).max())
+        if not np.isfinite(change):
+            return None
+        if change < tol and _complementary_rows(u + c, h, p, allowed).all():
+            return p, it, change
+    return None
