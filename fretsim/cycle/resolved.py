@@ -265,7 +265,6 @@ def coupled_positions(member, wear_moving, wear_stationary, normal, du: np.ndarr
     flat = np.broadcast_to(wear_stationary, (m,) + shape)
     factor = member.law.gross_slip_factor(member.friction_coefficient)
     idx, rest = np.flatnonzero(counted), np.flatnonzero(~counted)
-    k_m, k_s = member.k_moving, member.k_stationary
     for _ in range(MAX_ROUNDS):
         sweep = sweep_of(member, p, a, b - a, wear_stationary, counted)
         seen = wear_moving + _read(member, flat, a, b, sweep)
@@ -325,13 +324,11 @@ class Coupling:
         # past a reversal, where a position's points slide 12–15 % less and unevenly, its symmetric part was
         # indefinite on the contact.  With one ω_k a position, Ω·(C + s·M) is symmetric and positive (M = GΩ, G
         # the read-deposit Gram operator): CG weights each layer's inner products by ω_k (layer_weights).  What
-        # the points' own slips change in the wear the cycle then tallies is the pass's defect.
+        # the points' own slips change is put back as a lagged gap correction (remainder).
         on = np.ones(weight.shape, bool) if on is None else on
         self.omega = np.array([float(np.median(w[o])) if o.any() else float(np.median(w)) for w, o in zip(weight, on)])
         self.weight = np.broadcast_to(self.omega[:, None, None], weight.shape)
-        self.own = weight  # each point's own c·|ds|: what differs from ω_k is lagged (remainder), not left out —
-        #                    left out, it was an explicit part of the step's stiffness, and the tube in service
-        #                    (steps of 10⁶ cycles) grew a pressure checkerboard at cycle 2.3e8
+        self.own = weight  # each point's own c·|ds|: the wear the cycle tallies
         self.layer_weights = self.omega
         self.start, self.end = (np.median(x.reshape(m, -1), axis=1) for x in travel)
         kernel = getattr(extra, "kernel", None)
