@@ -11,7 +11,7 @@ import pytest
 from fretsim.compliance import add, scaled
 from fretsim.cycle import coulomb
 from fretsim.cycle.coulomb import increment_path
-from fretsim.cycle.resolved import Coupling, _read_symbol, coupled_positions, starts, sweep_of, travels
+from fretsim.cycle.resolved import Coupling, _read_symbol, starts, sweep_of, travels
 from fretsim.solvers import solve
 from fretsim.solvers.rows import solve_coupled, solve_rows
 from fretsim.wear import sweep_read

@@ -523,8 +523,8 @@ def _resolved_step(member: CoulombCycle, wear_moving, wear_stationary, normal, g
                             memory, cycle, detail, correction=correction, corrected=True,
                             predicted=None if cyc is None else cyc.positions)
         correction = cyc.mismatch
-    if cyc.positions:  # the next step's coupled solve starts from these
-        cyc.memory["positions"] = cyc.positions[0]
+    if COUPLED and cyc.positions:  # the next step's coupled solve starts from these (checkpointed: kept only
+        cyc.memory["positions"] = cyc.positions[0]  # where a coupled solve will read them)
     if detail is True and not member.rigid:  # the recorded loop, of the pass returned only (48 ms a 2D draw)
         u, q = turning_loop(member.stroke, max(LOOP_SIDE_INCREMENTS, member.increments), member._tangential,
                             member._elastic_side, *cyc.turns, member.grid.area * member.volume_factor)
