@@ -137,13 +137,34 @@ def checkerboard_signed(pressure: np.ndarray, edge: int = 3, stick: Optional[np.
     d2[:, 1:-1] = p[:, :-2] - 2 * p[:, 1:-1] + p[:, 2:]
     r = d2 * (1.0 - 2.0 * (idx % 2)) / 4.0
     count = interior.sum(axis=1)
-    rows = count >= 6
+    mean_p = (p * interior).sum(axis=1) / np.maximum(count, 1)
+    rows = (count >= 6) & (mean_p > 0)  # (a row with no pressure inside its span has no pattern to judge)
     if not rows.any():
         return 0.0
     mean_r = (r * interior).sum(axis=1)[rows] / count[rows]
-    mean_p = (p * interior).sum(axis=1)[rows] / count[rows]
+    mean_p = mean_p[rows]
     amp = -mean_r / mean_p
     return float(amp[np.argmax(np.abs(amp))])
+
+
+def odd_even_run(pressure: np.ndarray, share: float = 0.1) -> int:
+    """The longest run of elements along x over which the pressure alternates element by element: its second
+    difference changes sign from each element to the next, each above ``share`` of the row's mean contact pressure.
+    A checkerboard, even one that lifts every other element off, runs over the contact (16–40 elements on the tube
+    in service); a contact's edges, a peak at a turning edge or two patches of one position make runs of a few
+    (McColl's worn positions: at most 4) — where :func:`checkerboard_signed`'s mean over the span read them as
+    40 % patterns."""
+    p = np.atleast_2d(pressure)
+    if p.shape[1] < 4:
+        return 0
+    on = p > 0
+    mean = (p * on).sum(axis=1) / np.maximum(on.sum(axis=1), 1)
+    d2 = p[:, :-2] - 2.0 * p[:, 1:-1] + p[:, 2:]
+    big = np.abs(d2) > share * mean[:, None]
+    alt = big[:, :-1] & big[:, 1:] & (np.sign(d2[:, :-1]) == -np.sign(d2[:, 1:]))
+    edges = np.diff(np.pad(alt.astype(np.int8), ((0, 0), (1, 1))), axis=1)
+    starts, ends = np.nonzero(edges == 1), np.nonzero(edges == -1)
+    return int((ends[1] - starts[1]).max()) if starts[1].size else 0
 
 
 def checkerboard_amplitude(pressure: np.ndarray) -> float:

@@ -9,11 +9,12 @@ import numpy as np
 import pytest
 
 from fretsim.compliance import add, scaled
-from fretsim.cycle import coulomb
+from fretsim.cycle import coulomb, resolved
 from fretsim.cycle.coulomb import increment_path
 from fretsim.cycle.resolved import Coupling, _read_symbol, starts, sweep_of, travels
 from fretsim.solvers import solve
 from fretsim.solvers.rows import solve_coupled, solve_rows
+from fretsim.stability import odd_even_run
 from fretsim.wear import sweep_read
 
 from test_resolved_rows import LOAD, RADIUS, _cylinder, _member, _worn_gaps
@@ -69,6 +70,26 @@ def test_a_coupled_stack_meets_every_positions_contact_conditions_with_the_coupl
     # and the coupling mattered: the layers solved alone meet their own conditions, not the coupled ones
     alone = np.stack([r.pressure for r in solve_rows(c, gaps, LOAD, p, 1e-10)])
     assert _kkt(c, gaps, couple, alone).max() > 1e3 * _kkt(c, gaps, couple, p).max()
+
+
+def test_a_coupled_stack_whose_contact_outgrows_its_warm_starts_window_is_solved_over_the_whole_grid():
+    """A load block's first step starts from a contact a couple of elements wide (the tube in service at 5 N after
+    15 N); the solution is much wider than the warm starts' window.  The stack is solved again over the whole
+    grid and meets every layer's conditions as before (1e-6); on the window alone it is refused (None: the first
+    assertion shows the retry is what solves it)."""
+    from fretsim.solvers.rows import _coupled_window
+    grid, c, a = _cylinder(n=201)
+    shifts = np.linspace(-0.025, 0.025, 5)
+    gaps = _worn_gaps(grid, a, shifts)
+    couple = _symmetric_coupling(grid.size, len(shifts), 1e-6)
+    narrow = np.zeros(gaps.shape)
+    narrow[:, 0, 99:101] = 1.0
+    assert _coupled_window(c, gaps, LOAD, narrow, 1e-10, couple, narrow > 0) == (None, True)
+    found = solve_coupled(c, gaps, LOAD, narrow, 1e-10, couple)
+    assert found is not None
+    p = np.stack([r.pressure for r in found])
+    assert (p > 0).sum(axis=(1, 2)).min() > 20  # (it did outgrow the two elements)
+    assert (_kkt(c, gaps, couple, p) < 1e-6).all()
 
 
 def test_without_coupling_the_coupled_stack_is_the_stack_solved_layer_by_layer():
@@ -245,6 +266,32 @@ def test_a_coupled_resolved_step_leaves_every_position_in_contact_with_the_surfa
     before = _residual_after_the_step(member, c, base, corrected, h_m, h_s, step)
     assert mine < 0.06, mine
     assert before > 0.3, before
+
+
+class _Chequered(_ImplicitRows):
+    """The coupled solve's pressures with an odd-even pattern of half their value laid over them."""
+
+    def coupled(self, *args, **kwargs):
+        got = super().coupled(*args, **kwargs)
+        return None if got is None else (got[0] * (1.0 + 0.5 * (-1.0) ** np.arange(got[0].shape[-1])), got[1])
+
+
+def test_a_coupled_step_whose_positions_alternate_element_by_element_is_taken_by_the_corrected_passes(monkeypatch,
+                                                                                                    coupled):
+    """A coupled step answering odd-even wear with an odd-even pressure (resolved.ODD_EVEN_RUN) is not kept: the
+    step is the corrected passes', to round-off; with the limit lifted the pattern would have been the step's."""
+    member, grid, c, a = _member(0.025)
+    base = grid.x[None, :] ** 2 / (2 * RADIUS)
+    h_m, h_s, guess, memory = _worn_by_the_model(member, _ImplicitRows(c, base))
+    chequered = member.solve(h_m, h_s, _Chequered(c, base), guess, step=300.0, memory=memory, detail=False)
+    with monkeypatch.context() as m:
+        m.setattr(coulomb, "COUPLED", False)
+        corrected = member.solve(h_m, h_s, _ImplicitRows(c, base), guess, step=300.0, memory=memory, detail=False)
+    assert np.array_equal(chequered.positions[0], corrected.positions[0])
+    with monkeypatch.context() as m:
+        m.setattr(resolved, "ODD_EVEN_RUN", 10 ** 9)
+        kept = member.solve(h_m, h_s, _Chequered(c, base), guess, step=300.0, memory=memory, detail=False)
+    assert odd_even_run(kept.positions[0].reshape(-1, grid.shape[-1])) >= resolved.ODD_EVEN_RUN
 
 
 def test_a_resolved_run_with_coupled_steps_matches_the_run_cycle_by_cycle(coupled):

@@ -205,11 +205,32 @@ def test_a_3d_resolved_run_stepped_as_stacks_stays_within_the_estimates_of_the_r
     within the larger of the two runs' own depth estimates (measured 1.0e-4 and 1.8e-4 against 2.5e-4 and 2.9e-4),
     volumes within 1e-5 (measured 1.1e-6)."""
     overrides = ("model.dimension=3d", "grid.elements=[151, 9]", "loading.cycles=300", "output.snapshots=[0, 300]")
+    # (both correct pass by pass, as the 2D comparison above: the coupled step has no one-by-one counterpart, and
+    #  its own short-run estimate is the xfail below)
+    monkeypatch.setattr(coulomb, "COUPLED", False)
     a, b = _run(True, monkeypatch, *overrides).summary, _run(False, monkeypatch, *overrides).summary
     allowed = max(a["error_estimate_depth"], b["error_estimate_depth"])
     for key in ("centre_wear_depth_stationary_um", "max_wear_depth_moving_um"):
         assert abs(a[key] / b[key] - 1.0) <= allowed, key
     assert a["wear_volume_stationary_mm3"] == pytest.approx(b["wear_volume_stationary_mm3"], rel=1e-5)
+
+
+@pytest.mark.slow
+@pytest.mark.xfail(strict=True, reason="known (issue 30, fourth round): in short runs the stepping estimate misses "
+                                       "what the coupled steps of the first ~50 cycles get wrong")
+def test_a_short_3d_resolved_run_with_coupled_steps_stays_within_its_stepping_estimate(monkeypatch):
+    """McColl 185 N 3D (151 × 9), 300 cycles, BDF2 at the default tolerance (1e-2) against the same run at
+    1e-4: each reported depth within the run's own stepping estimate (both errors are inside the depth target,
+    tolerance × DEPTH_SHARE = 7e-4; the estimate is what under-states them).  Measured: +5.2e-4 (flat's centre) and +5.9e-4
+    (moving body) against an estimate of 9.4e-5; the corrected passes made +2.3e-4 and +3.8e-4 against 2.5e-4 —
+    the BDF2 estimate of the first steps is far below the error they make in both, and the corrected passes'
+    larger defect covered most of it.  Strict: it fails loudly once the estimate covers the start."""
+    overrides = ("model.dimension=3d", "grid.elements=[151, 9]", "loading.cycles=300", "output.snapshots=[0, 300]")
+    monkeypatch.setattr(coulomb, "COUPLED", True)  # (whatever the default)
+    run = _run(True, monkeypatch, *overrides).summary
+    tight = _run(True, monkeypatch, *overrides, "jumping.tolerance=0.0001").summary
+    for key in ("centre_wear_depth_stationary_um", "max_wear_depth_moving_um"):
+        assert abs(run[key] / tight[key] - 1.0) <= run["error_estimate_depth"], key
 
 
 def test_a_row_started_on_one_element_takes_the_single_solves_admitting_step_not_a_failure():

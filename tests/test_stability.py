@@ -5,7 +5,7 @@ import pytest
 from conftest import E_STAR
 from fretsim.compliance import HalfSpace, Matrix, Sum, add, scaled
 from fretsim.grid import Grid
-from fretsim.stability import (NOISE_FLOOR, GrowthWatch, checkerboard_amplitude, checkerboard_signed,
+from fretsim.stability import (NOISE_FLOOR, GrowthWatch, checkerboard_amplitude, checkerboard_signed, odd_even_run,
                                default_linear_jump, wear_spectrum)
 from fretsim.wear import wear_operator
 
@@ -112,6 +112,32 @@ def test_detector_sees_a_strong_checkerboard_whose_troughs_touch_zero():
     x = np.linspace(-1, 1, 41)
     strong = np.where(np.abs(x) < 0.9, 200.0, 0.0) * (1 + 0.98 * (-1.0) ** np.arange(41))
     assert checkerboard_amplitude(strong[None, :]) > 0.5
+
+
+def test_an_odd_even_run_is_long_for_a_checkerboard_and_short_for_edges_peaks_and_two_patches():
+    """odd_even_run counts the elements over which the pressure alternates: a checkerboard lifting every other
+    element off (as the tube in service's coupled step made) runs over its whole contact; a worn resolved
+    position's shapes (a sharp turning-edge peak, a second patch a few elements wide, a hole between them) make a
+    run of at most 4 — which checkerboard_signed's span mean read as a 40 % pattern."""
+    x = np.linspace(-1, 1, 61)
+    hertz = np.sqrt(np.clip(1 - x**2, 0, None)) * 100
+    lifting = np.where(np.arange(61) % 2 == 0, 2 * hertz, 0.0)[None, :]
+    assert odd_even_run(lifting) >= 50
+    assert odd_even_run((hertz * (1 + 0.3 * (-1.0) ** np.arange(61)))[None, :]) >= 50
+    flat = np.where(np.abs(x) < 0.6, 130.0 + 5 * x, 0.0)
+    flat[np.flatnonzero(np.abs(x) < 0.6)[-1]] = 2700.0  # the turning edge's peak, one element
+    flat[3:8] = [1650.0, 1980.0, 1920.0, 2310.0, 3540.0]  # a second patch, five elements, beyond a hole
+    assert odd_even_run(flat[None, :]) <= 4
+    assert checkerboard_amplitude(flat[None, :]) > 0.1  # (the span mean is fooled by the same shapes)
+    assert odd_even_run(hertz[None, :]) == 0
+
+
+def test_the_odd_even_amplitude_of_a_contact_with_nothing_inside_its_span_is_zero_not_nan():
+    """A row whose contact is two patches with no pressure between them has no pattern inside its span: 0, not the
+    0/0 it was."""
+    p = np.zeros((1, 40))
+    p[0, 2:4] = p[0, 36:38] = 50.0
+    assert checkerboard_signed(p) == 0.0
 
 
 def _watch(g: float, excitation: float, steps: int):

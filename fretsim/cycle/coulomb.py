@@ -75,8 +75,11 @@ RESOLVED_CORRECTIONS = 3  # ... every step of the resolved stroke that cannot be
 # estimate of 0.17 %: every step corrects RESOLVED_CORRECTIONS times, +0.025 % against 0.031 %; tests/test_friction.py)
 COUPLED = False  # a resolved implicit step solves its positions coupled by the step's wear (resolved.coupled_positions):
 #                 built and tested, not the default — 2D McColl 185 N 5× the mid-stroke run instead of 10×, 3D 17×
-#                 instead of 23×, widths nearer the run cycle by cycle, but the tube in service (2D, μ 0.9,
-#                 bdf2 and implicit) grew a pressure checkerboard at cycle 2.3e8 where the corrected passes complete
+#                 instead of 23×, widths nearer the run cycle by cycle, and with its odd-even guard (resolved.
+#                 ODD_EVEN_RUN) the tube in service completes under BDF2 and backward Euler in a seventh of the time;
+#                 but at jumping.tolerance 0.001 the tube in service still stops at 2.3328e8 with a 65 % odd-even
+#                 pressure (the guard then sends 2 011 of 2 660 steps to the corrected passes), and whether the
+#                 corrected passes survive that setting is not yet measured (scripts/results/resolved_coupled_3d.txt)
 RESOLVED_PASSES = 1 + RESOLVED_CORRECTIONS  # the cost estimate's passes per resolved implicit step; a coupled step
 #                                             costs about as much over the run (its CG takes 2–4 times a pass's
 #                                             iterations, the run about 0.6 times the steps the estimate counts):

@@ -188,11 +188,22 @@ def solve_coupled(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float,
     convex problem, so Polonsky–Keer's iteration carries over with one step length for the stack and each layer's
     load kept by its own mean gap (its approach).  On the window of the warm starts, verified on the whole grid as
     :func:`solve_rows` verifies; ``couple`` acts on whole-grid stacks.  A ContactResult per layer, or None if the
-    stack did not converge or outgrew its window (the caller then solves it another way)."""
+    stack did not converge (the caller then solves it another way); a stack whose contact outgrew the warm starts'
+    window is solved again over the whole grid."""
     m, ny, nx = gaps.shape
     on = p0 > 0
     if not on.any(axis=A).all() or (np.isnan(gaps) | np.isneginf(gaps)).any():
         return None
+    found, outgrew = _coupled_window(op, gaps, load, p0, tol, couple, on)
+    if outgrew:  # (a load block's first step, from a contact a few elements wide): once more over the whole grid
+        found, _ = _coupled_window(op, gaps, load, p0, tol, couple, np.ones(on.shape, bool))
+    return found
+
+
+def _coupled_window(op, gaps, load, p0, tol, couple, on) -> tuple:
+    """solve_coupled on the window of ``on`` (and its margin): (a ContactResult per layer or None, whether the
+    contact outgrew a window smaller than the grid)."""
+    m, ny, nx = gaps.shape
     rows, cols = _span(on.any(axis=(0, 2)), ny), _span(on.any(axis=(0, 1)), nx)
     whole = rows.stop - rows.start == ny and cols.stop - cols.start == nx
     win = op if whole else op.window(rows, cols)
@@ -206,7 +217,7 @@ def solve_coupled(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float,
     found = cg_coupled(win, gaps[:, rows, cols], load, p0[:, rows, cols], tol, couple_win, precond,
                        getattr(couple, "layer_weights", None))
     if found is None:
-        return None
+        return None, False
     p = np.zeros(gaps.shape)
     p[:, rows, cols] = found[0]
     its, err = found[1], found[2]
@@ -219,7 +230,7 @@ def solve_coupled(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float,
     inside = np.zeros((ny, nx), bool)
     inside[rows, cols] = True
     if (~inside & (y < -WINDOW_PENETRATION * scale[:, None, None])).any():
-        return None
+        return None, not whole
     worst = np.maximum(np.where(on, np.abs(y), 0.0).max(axis=A),
                        np.where(~on & finite, np.clip(-y, 0.0, None), 0.0).max(axis=A))
     spread = u.max(axis=A) - u.min(axis=A)
@@ -227,7 +238,7 @@ def solve_coupled(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float,
     return [ContactResult(p[k], float(approach[k]), on[k], its, True,
                           f"cg converged in {its} iterations (relative pressure change {err:.1e} < {tol:.0e}, gap "
                           f"complementary; coupled with {m - 1} other positions by the step's wear)",
-                          float(residual[k])) for k in range(m)]
+                          float(residual[k])) for k in range(m)], False
 
 
 def cg_coupled(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float, couple, precond, layer_weights=None):
