@@ -130,7 +130,7 @@ def cg_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float):
         change = np.abs(p - p_old).sum(axis=A) / total
         bad = ~still & ~np.isfinite(change)  # (a row that took no step keeps its last change, inf before its first)
         err = np.where(still, err, change)
-        fin = done | bad | ((err < tol) & _complementary_rows(u, hl, p, al) & ~still)
+        fin = done | bad | ((err < tol) & ~pen & _complementary_rows(u, hl, p, al) & ~still)  # (as solve_cg)
         if fin.any() or it == max_iter:
             if it == max_iter:
                 fin = np.ones(live.size, bool)
