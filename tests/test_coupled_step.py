@@ -13,7 +13,7 @@ from fretsim.cycle import coulomb, resolved
 from fretsim.cycle.coulomb import increment_path
 from fretsim.cycle.resolved import Coupling, _read_symbol, starts, sweep_of, travels
 from fretsim.solvers import solve
-from fretsim.solvers.rows import solve_coupled, solve_rows
+from fretsim.solvers.rows import solve_coupled, solve_mirrored_rows, solve_rows
 from fretsim.stability import odd_even_run
 from fretsim.wear import sweep_read
 
@@ -206,9 +206,9 @@ class _ImplicitRows:
         res = solve(self._op(extra), self.base + seen, load, p0=guess, tol=1e-10)
         return res.pressure, res
 
-    def rows(self, seen, guess, extra=None, load=LOAD, cycle=0):
-        found = solve_rows(self._op(extra), self.base + seen, load, guess, 1e-10)
-        found = [r if r is not None else self(seen[k], guess[k], extra)[1] for k, r in enumerate(found)]
+    def rows(self, seen, guess, extra=None, load=LOAD, cycle=0, mirrors=()):
+        found = solve_mirrored_rows(self._op(extra), self.base + seen, load, guess, 1e-10, mirrors,
+                                    lambda k: self(seen[k], guess[k], extra)[1])
         return np.stack([r.pressure for r in found]), found
 
     def coupled(self, seen, guess, couple, extra=None, load=LOAD, cycle=0):

@@ -52,7 +52,8 @@ import numpy as np
 
 from fretsim.compliance import scaled
 from fretsim.cycle.loop import LOOP_SIDE_INCREMENTS, elastic_side, loop_path, turning_loop
-from fretsim.cycle.resolved import TRAVEL_TOLERANCE, add_rows, coupled_positions, mismatch_rows, positions, sweep_of
+from fretsim.cycle.resolved import (TRAVEL_TOLERANCE, add_rows, coupled_positions, mirror_images, mismatch_rows,
+                                    positions, sweep_of)
 from fretsim.cycle.result import TRACTIONS, Cycle, CycleError, CycleSpec, stick_half_width
 from fretsim.grid import Grid
 from fretsim.solvers.tangential import solve_tangential
@@ -251,7 +252,8 @@ class CoulombCycle:
         if self.resolved and detail is True and not self.rigid and not corrected:  # (a corrected pass draws no loop)
             tally.loop_u, tally.loop_q = turning_loop(self.stroke, max(LOOP_SIDE_INCREMENTS, self.increments),
                                                       self._tangential, self._elastic_side, (q_low, p_low),
-                                                      (q_high, p_high), tally.area)
+                                                      (q_high, p_high), tally.area,
+                                                      mirror_images(self, (q_low, p_low), (q_high, p_high)))
         defect, mismatch = _step_defect(self, wear_moving, wear_stationary, step, w_lin, tally, stacks, p_mid,
                                         travel_mid, correction, mid, corrected, visits) if step else (0.0, None)
         cyc = tally.cycle(self, p_mid, res_mid, stick_end, defect, mismatch)
@@ -530,7 +532,8 @@ def _resolved_step(member: CoulombCycle, wear_moving, wear_stationary, normal, g
         cyc.memory["positions"] = cyc.positions[0]  # where a coupled solve will read them)
     if detail is True and not member.rigid:  # the recorded loop, of the pass returned only (48 ms a 2D draw)
         u, q = turning_loop(member.stroke, max(LOOP_SIDE_INCREMENTS, member.increments), member._tangential,
-                            member._elastic_side, *cyc.turns, member.grid.area * member.volume_factor)
+                            member._elastic_side, *cyc.turns, member.grid.area * member.volume_factor,
+                            mirror_images(member, *cyc.turns))
         cyc.loop, cyc.force_amplitude = (np.array(u), np.array(q)), float(np.abs(q).max())
     return cyc
 

@@ -46,14 +46,21 @@ def loop_path(stroke: float, side: float, increments: int) -> list[tuple[float, 
 
 
 def turning_loop(stroke: float, increments: int, tangential_increment: Callable, side_of: Callable, low: tuple,
-                 high: tuple, area: float) -> tuple[list, list]:
+                 high: tuple, area: float, mirrored: bool = False) -> tuple[list, list]:
     """A resolved stroke's recorded loop: each half-stroke drawn from its turning point (U = ∓δ; ``low`` and
     ``high`` the (traction, pressure) the cycle found there) on the pressure at that turning point.  The resolved
     stroke's increments are a quadrature along the stroke, evenly spaced; the pressure changes little over the
     side's 2δ_t (a fraction of an element), so holding it there draws the side as it is, for tangential solves
-    only.  ``tangential_increment(q, p, du)`` → (q, ds, stick, iterations); ``side_of(p)`` → 2δ_t (mm)."""
+    only.  ``tangential_increment(q, p, du)`` → (q, ds, stick, iterations); ``side_of(p)`` → 2δ_t (mm).
+    ``mirrored``: the cycle is symmetric along x (its turning states each other's mirror image, with the tangential
+    compliance's kernel even), so the down half is the up half mirrored: its force the up half's negated."""
     us, qs = [-stroke], [float(low[0].sum()) * area]
     for (q, p), sign in ((low, +1), (high, -1)):  # the down half starts from the cycle's own state at +δ
+        if sign < 0 and mirrored:
+            half = len(us) - 1
+            us.extend(-u for u in us[1:half + 1])
+            qs.extend(-f for f in qs[1:half + 1])
+            break
         for u0, u1 in half_stroke(stroke, side_of(p), sign, increments):
             q = tangential_increment(q, p, u1 - u0)[0]
             us.append(u1)

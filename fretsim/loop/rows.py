@@ -14,7 +14,7 @@ import numpy as np
 from fretsim.compliance import add
 from fretsim.compliance.operator import Convolution
 from fretsim.loop import checks
-from fretsim.solvers.rows import solve_coupled, solve_rows
+from fretsim.solvers.rows import mirror_symmetric, mirror_tolerance, solve_coupled, solve_mirrored_rows
 
 
 class NormalSolve:
@@ -24,6 +24,18 @@ class NormalSolve:
     def __init__(self, loop):
         self.loop = loop
         self._summed = (None, None, None)
+        self._symmetric = (None, False)
+
+    def mirror_tolerance(self, extra, peak: float) -> float:
+        """How far (mm) a worn gap may be from its mirror image and its contact still be taken as the mirrored one
+        (:func:`fretsim.solvers.rows.mirror_tolerance`); 0 where the problem itself is not symmetric along x
+        (the unworn gap on a centred grid, the operator), to round-off."""
+        s = self.loop.s
+        key = (id(s.gap), id(s.compliance))
+        if self._symmetric[0] != key:
+            self._symmetric = (key, self.stacks and mirror_symmetric(s.compliance, s.gap, s.grid.x))
+        op = self._operator(extra) if self._symmetric[1] else None
+        return mirror_tolerance(op, s.tolerance, peak) if op is not None else 0.0
 
     def __call__(self, seen, guess, extra=None, load: Optional[float] = None, cycle: int = 0):
         return self.loop.normal(seen, guess, extra, load=load, cycle=cycle)
@@ -60,10 +72,12 @@ class NormalSolve:
         checks.check_edges(pressures.max(axis=0), s.band, s.grid, cycle, s.y_edges_free)
         return pressures, found
 
-    def rows(self, seen: np.ndarray, guess: np.ndarray, extra=None, load: Optional[float] = None, cycle: int = 0):
+    def rows(self, seen: np.ndarray, guess: np.ndarray, extra=None, load: Optional[float] = None, cycle: int = 0,
+             mirrors=()):
         """(pressures (m, My, Mx), a ContactResult per layer) for the gaps ε + ``seen`` (m, My, Mx), warm-started
         from ``guess`` (m, My, Mx); None where they cannot be solved together.  A row the stack did not settle is
-        solved alone, with the single solve's fallbacks and checks; every row is checked as a single solve is."""
+        solved alone, with the single solve's fallbacks and checks; every row is checked as a single solve is.
+        ``mirrors``: pairs of rows that may be mirror images along x (:func:`fretsim.solvers.rows.solve_mirrored_rows`)."""
         loop = self.loop
         s = loop.s
         if not self.stacks:
@@ -71,15 +85,17 @@ class NormalSolve:
         op = self._operator(extra)
         if op is None:
             return None
-        found = solve_rows(op, s.gap + seen, load, guess, s.tolerance)
+        alone = {}
+
+        def single(k):  # a row the stack did not settle: the single solve, its fallbacks and its own checks
+            alone[k] = True
+            return loop.normal(seen[k], guess[k], extra, load=load, cycle=cycle)[1]
+        found = solve_mirrored_rows(op, s.gap + seen, load, guess, s.tolerance, mirrors, single)
         pressures, results = np.zeros(seen.shape), []
         for k, res in enumerate(found):
-            if res is None:
-                p, res = loop.normal(seen[k], guess[k], extra, load=load, cycle=cycle)
-            else:
+            if k not in alone:
                 checks.check_solution(res, op.grid.area, load, s.method, cycle, loop.n)
-                p = res.pressure
-            pressures[k] = p
+            pressures[k] = res.pressure
             results.append(res)
         checks.check_edges(pressures.max(axis=0), s.band, s.grid, cycle, s.y_edges_free)  # every layer's at once
         return pressures, results

@@ -90,14 +90,14 @@ class _Normal:
                     p0=guess, tol=self.setup.tolerance)
         return res.pressure, res
 
-    def rows(self, seen, guess, extra=None, load=None, cycle=0):
+    def rows(self, seen, guess, extra=None, load=None, cycle=0, mirrors=()):
         from fretsim.compliance.operator import Convolution
-        from fretsim.solvers.rows import solve_rows
+        from fretsim.solvers.rows import solve_mirrored_rows
         op = self.op if extra is None else add(self.op, extra)
         if self.setup.coarse_compliance is not None or self.setup.method != "cg" or not isinstance(op, Convolution):
             return None
-        found = solve_rows(op, self.gap + seen, load, guess, self.setup.tolerance)
-        found = [r if r is not None else self(seen[k], guess[k], extra, load)[1] for k, r in enumerate(found)]
+        found = solve_mirrored_rows(op, self.gap + seen, load, guess, self.setup.tolerance, mirrors,
+                                    lambda k: self(seen[k], guess[k], extra, load)[1])
         return np.stack([r.pressure for r in found]), found
 
 

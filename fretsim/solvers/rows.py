@@ -67,6 +67,74 @@ def solve_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float) ->
             for k in range(m)]
 
 
+MIRROR_SHARE = 0.01  # of the solver's tolerance: a gap this much off its mirror image (on the scale of one element's
+#                      own compliance at the peak pressure) is the same contact mirrored.  The solver stops at a 1e-5
+#                      relative pressure change, so two layers solved apart differ by about that much, and the wear
+#                      they deposit is that much asymmetric: noise the mirror must not refuse, far below what moves a
+#                      pressure by what the solver itself leaves
+
+
+def mirror_tolerance(op, tol: float, peak: float) -> float:
+    """The largest difference of a gap from its mirror image (mm) under which its contact is taken as the mirrored
+    contact: MIRROR_SHARE of the solver's relative tolerance, at the peak pressure, over the stiffness of one
+    element against its neighbour (K₀ − K₁ along x, the kernel's additive constant aside); 0 where the operator
+    is not itself symmetric along x (an even kernel: every half-space's; checked, not assumed)."""
+    kernel = getattr(op, "kernel", None)
+    if kernel is None or kernel.shape[1] < 3 or not np.array_equal(kernel, kernel[:, ::-1]):
+        return 0.0
+    cy, cx = kernel.shape[0] // 2, kernel.shape[1] // 2
+    return max(MIRROR_SHARE * tol * peak * float(kernel[cy, cx] - kernel[cy, cx + 1]), 0.0)
+
+
+def mirrored_layers(op, gaps: np.ndarray, pairs, tol: float, peak: float) -> dict:
+    """{j: i} for the pairs (i, j) whose gaps are mirror images along x to :func:`mirror_tolerance`.  The contact
+    of a mirrored gap is the mirrored contact (the problem, the load and the solver's rule are all symmetric), so
+    it is taken, not solved again: a symmetric fretting cycle's down-stroke is its up-stroke mirrored."""
+    within = mirror_tolerance(op, tol, peak)
+    copies = {}
+    for i, j in pairs if within > 0 else ():
+        a, b = gaps[i], gaps[j][:, ::-1]
+        finite = np.isfinite(a)
+        if i in copies or j in copies or not np.array_equal(finite, np.isfinite(b)) or not finite.any():
+            continue
+        if np.abs(a[finite] - b[finite]).max() <= within:
+            copies[j] = i
+    return copies
+
+
+def solve_mirrored_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float, mirrors, alone) -> list:
+    """:func:`solve_rows` with ``mirrors``, pairs (i, j) of layers that may be mirror images along x (a symmetric
+    cycle's up- and down-stroke at the same |U|): where the gaps are (:func:`mirrored_layers`), layer j is layer
+    i's contact mirrored, not solved.  ``alone(k)`` solves layer k by itself (the single solve, with its fallbacks)
+    where the stack could not; a mirrored layer is then that solve mirrored, so the pair stays one contact."""
+    m = gaps.shape[0]
+    copies = mirrored_layers(op, gaps, mirrors, tol, float(p0.max())) if len(mirrors) else {}
+    keep = [k for k in range(m) if k not in copies]
+    found = dict(zip(keep, solve_rows(op, gaps[keep], load, p0[keep], tol)))
+    found = {k: res if res is not None else alone(k) for k, res in found.items()}
+    for j, i in copies.items():
+        found[j] = mirror_result(found[i])
+    return [found[k] for k in range(m)]
+
+
+def mirror_symmetric(op, gap: np.ndarray, x: np.ndarray) -> bool:
+    """Whether a contact problem is itself symmetric along x, to round-off: a centred grid, an even kernel and an
+    unworn gap that is its own mirror image (1e-12 of its largest finite value)."""
+    kernel = getattr(op, "kernel", None)
+    if kernel is None or not np.array_equal(kernel, kernel[:, ::-1]) or not np.array_equal(x, -x[::-1]):
+        return False
+    finite = np.isfinite(gap)
+    if not np.array_equal(finite, finite[:, ::-1]) or not finite.any():
+        return False
+    return bool(np.abs(gap[finite] - gap[:, ::-1][finite]).max() <= 1e-12 * np.abs(gap[finite]).max())
+
+
+def mirror_result(res):
+    """A ContactResult mirrored along x."""
+    return ContactResult(res.pressure[:, ::-1].copy(), res.approach, res.contact[:, ::-1].copy(), 0, res.success,
+                         res.message + "; the mirror image of its pair's", res.residual)
+
+
 def _span(mask: np.ndarray, n: int) -> slice:
     """The warm starts' extent along one axis and the single solve's margin round it (solvers.WINDOW_MARGIN)."""
     idx = np.flatnonzero(mask)
