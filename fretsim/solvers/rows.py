@@ -369,6 +369,6 @@ def cg_coupled(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float, co
         change = float((np.abs(p - p_old).sum(axis=A) / total).max())
         if not np.isfinite(change):
             return None
-        if change < tol and _complementary_rows(u + c, h, p, allowed).all():
+        if change < tol and not pen.any() and _complementary_rows(u + c, h, p, allowed).all():  # (as solve_cg)
             return p, it, change
     return None
