@@ -362,3 +362,14 @@ def test_a_recorded_loops_down_half_drawn_as_the_up_half_mirrored_equals_the_one
     u0, q0 = turning_loop(*args, mirrored=False)
     assert np.allclose(u1, u0, rtol=0, atol=1e-12)
     assert np.abs(np.array(q1) - np.array(q0)).max() < 1e-8 * np.abs(q0).max()
+
+
+def test_a_symmetric_cycle_whose_warm_start_is_not_symmetric_is_predicted_from_it_made_symmetric(monkeypatch):
+    """Behind a compliant rig (loading.tangential_stiffness) mid-stroke's contact, the warm start, sits off centre
+    (16 elements here) while the problem is symmetric.  The first prediction put the quarter at the warm start
+    mirrored and every other position at the warm start, so the quarter's traction was elsewhere than the
+    up-stroke's contact: the tangential solve from it did not converge in 1000 iterations and the run failed
+    (at cycle 780 of 800).  Predicted from the warm start made symmetric, it completes."""
+    out = _run(True, monkeypatch, "loading.cycles=800", "output.snapshots=[0, 800]",
+               "loading.tangential_stiffness=20 N/um")
+    assert out.status == "complete" and out.summary["cycles"] == 800, out.message

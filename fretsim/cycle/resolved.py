@@ -162,9 +162,13 @@ def positions(member, wear_moving, wear_stationary, normal, du: np.ndarray, gues
     turn = _turn(du, pairs) if pairs and _symmetric(member, normal, moving, wear_stationary, pairs, extra, start) \
         else None
     if predicted is None:
-        p = np.repeat(guess[None], m, axis=0)
-        if turn is not None:
-            p[turn[0]] = p[turn[1]][..., ::-1]
+        # (a symmetric cycle's from the warm start made symmetric: the quarter is the up-stroke's end mirrored, and
+        #  it is where the up-stroke starts, so a prediction whose quarter is not its first position's contact puts
+        #  the up-stroke's first traction elsewhere than its contact — the warm start mirrored for the quarter and
+        #  the warm start for the rest did, where mid-stroke's contact, behind a compliant rig, sits 16 elements off
+        #  centre: the tangential solve from it did not converge and the run failed.  The prediction's travels are
+        #  also each other's mirror images then, as the pairs' gaps must be for the stack to take them mirrored.)
+        p = np.repeat((0.5 * (guess + guess[..., ::-1]) if turn is not None else guess)[None], m, axis=0)
         found = travels(member, p, du, budget=m // PARTIAL_SHARE, mirror=pairs if turn is not None else ())
         if found is None:  # partial slip: the prediction alone would cost what the pass one by one costs
             return None
