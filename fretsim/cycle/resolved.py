@@ -45,7 +45,7 @@ from typing import Optional
 
 import numpy as np
 
-from fretsim.solvers.rows import mirror_result
+from fretsim.solvers.rows import even_along_x, mirror_result
 from fretsim.stability import odd_even_run
 from fretsim.wear import Sweep, _hat_integral, sweep_read
 
@@ -238,7 +238,7 @@ def _symmetric(member, normal, moving: np.ndarray, flat: np.ndarray, pairs: list
     within = find(extra, float(p.max())) if find is not None else 0.0
     if not member.rigid:
         kernel = getattr(member.tangential, "kernel", None)
-        within = within if kernel is not None and np.array_equal(kernel, kernel[:, ::-1]) else 0.0
+        within = within if even_along_x(kernel) else 0.0
     return within > 0 and bool(np.abs(flat - flat[..., ::-1]).max() <= within and
                                all(np.abs(moving[i] - moving[j][..., ::-1]).max() <= within for i, j in pairs))
 
@@ -248,7 +248,7 @@ def mirror_images(member, low: tuple, high: tuple) -> bool:
     (exactly: a symmetric cycle's are, :func:`positions`) under a tangential compliance that is itself symmetric:
     then its loop's down half is its up half mirrored."""
     kernel = getattr(member.tangential, "kernel", None)
-    return kernel is not None and np.array_equal(kernel, kernel[:, ::-1]) and \
+    return even_along_x(kernel) and \
         np.array_equal(high[1], low[1][..., ::-1]) and np.array_equal(high[0], -low[0][..., ::-1])
 
 
