@@ -159,3 +159,16 @@ def test_growth_watch_ignores_a_stable_mode_rising_to_a_plateau_above_the_noise_
 def test_growth_watch_catches_growth_within_steps_of_becoming_visible(g):
     caught, amplitude = _watch(g, 1e-6, 2000)
     assert caught is not None and amplitude < 2 * NOISE_FLOOR * g  # at the first step above the floor
+
+
+def test_a_resolved_strokes_growing_pattern_is_reported_with_its_own_cause_and_what_to_change():
+    """Under implicit steps a growing odd-even pattern is the cycle model's own.  For the resolved stroke the
+    partial-slip reading alone (refine the grid) was the wrong advice: the tube in service, in gross slip, grew one
+    at jumping.tolerance 0.001 from wear a load block's positions never read, and completes at the default 0.01
+    or at mid-stroke.  The failure names that cause and those changes; the mid-stroke cycle keeps its own."""
+    from types import SimpleNamespace
+    from fretsim.loop.checks import model_growth_cause
+    resolved = model_growth_cause(SimpleNamespace(resolved=True, rigid=False, linear=False, name="coulomb"), None)
+    assert "resolved stroke" in resolved and "jumping.tolerance" in resolved and "model.stroke: mid_stroke" in resolved
+    mid = model_growth_cause(SimpleNamespace(resolved=False, rigid=False, linear=False, name="coulomb"), None)
+    assert "resolved" not in mid and "grid.elements" in mid

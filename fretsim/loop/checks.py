@@ -95,6 +95,14 @@ def growth_failure(n: int, amplitude: float, cause: str) -> NumericalFailure:
 
 def model_growth_cause(model, setup) -> str:
     """Why a checkerboard grows under steps that have no stability limit: the cycle model itself."""
+    if getattr(model, "resolved", False) and not getattr(model, "rigid", False):
+        return ("the implicit steps have no stability limit, so the resolved stroke itself grew it: its positions "
+                "read the flat at fractions of an element, so wear one load block lays down can alternate in a way "
+                "none of its positions read, and a later block's positions, at other fractions, answer it with an "
+                "alternating pressure (the tube in service does this at jumping.tolerance 0.001 and completes at the "
+                "default 0.01: docs/verification.md); where the contact partly sticks, a coarse grid grows such a "
+                "pattern at the stick zone's edge. Loosen jumping.tolerance, refine the grid (grid.elements) where "
+                "the contact sticks, or set model.stroke: mid_stroke, which reads no positions")
     if not model.linear:
         return (f"the implicit steps have no stability limit, so the {model.name} cycle itself grew it: where the "
                 f"contact partly sticks, more pressure means less slip and less wear, and on a coarse grid that "
