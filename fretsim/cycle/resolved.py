@@ -60,6 +60,11 @@ STACK_LIMIT = 60_000  # elements of a whole stack (positions × grid) beyond whi
 #                      185 N 3D (19 × 27 × 263 = 135 000) took 97.9 s stacked against 87.5 s one by one (84 s with
 #                      the normal solves in chunks), where 2D (19 × 427) is 4.2× faster stacked and the ball in gross
 #                      slip (19 × 25 × 85 = 40 000) 1.5×
+MIRRORED_STACK_LIMIT = 250_000  # ... and a symmetric cycle's, which solves half its positions (the others mirrored):
+#                                McColl 185 N 3D (19 × 27 × 427 = 219 000) took 74 s stacked and mirrored against 115 s
+#                                increment by increment (two runs each, in both orders, a second job on the machine),
+#                                its mid-stroke pressure smooth where the one by one's, from the quarter, is noisy
+#                                (±1.5 MPa element to element on 71 MPa; its peak 3.6 % higher on a noise spike)
 COUPLED_LIMIT = 1_000_000  # elements of a whole stack beyond which an implicit step corrects pass by pass
 OWN_SLIP_PASSES = 3  # coupled solves again with each point's own slip lagged (Coupling.remainder), at most
 OWN_SLIP_TOLERANCE = 1e-3  # ... until what it adds moves by less than this share of the step's largest wear
@@ -151,7 +156,7 @@ def positions(member, wear_moving, wear_stationary, normal, du: np.ndarray, gues
     rows = getattr(normal, "rows", None)
     m, shape = du.size, member.grid.shape
     if rows is None or not getattr(normal, "stacks", True) or (predicted is None and guess is None) or \
-            predicted == () or m * member.grid.size > STACK_LIMIT:
+            predicted == () or m * member.grid.size > MIRRORED_STACK_LIMIT:
         return None  # (predicted (): the step's last pass went one by one)
     moving = wear_moving + (np.stack(correction) if correction is not None else 0.0)
     moving = np.broadcast_to(moving, (m,) + shape)
@@ -161,6 +166,8 @@ def positions(member, wear_moving, wear_stationary, normal, du: np.ndarray, gues
     start = guess if predicted is None else predicted[0]
     turn = _turn(du, pairs) if pairs and _symmetric(member, normal, moving, wear_stationary, pairs, extra, start) \
         else None
+    if turn is None and m * member.grid.size > STACK_LIMIT:
+        return None
     if predicted is None:
         # (a symmetric cycle's from the warm start made symmetric: the quarter is the up-stroke's end mirrored, and
         #  it is where the up-stroke starts, so a prediction whose quarter is not its first position's contact puts
