@@ -23,8 +23,9 @@ one stack (where the stack is small enough to gain: STACK_LIMIT):
   mirrored: normal contacts taken, not solved (:func:`fretsim.solvers.rows.solve_mirrored_rows`, each checked
   against its pair's gap), travels and tractions mirrored.  Its deposits are mirrored too, so the state stays
   symmetric to round-off; before, the quarter's start and the solver's tolerance left the flat 3e-4 asymmetric
-  after 18 000 cycles of McColl 185 N.  It pays less than half: a stack's cost is mostly per call, not per layer
-  (McColl 185 N 2D: the loop 0.88×).
+  after 18 000 cycles of McColl 185 N.  It pays less than half in 2D, where a stack's cost is mostly per call, not
+  per layer (McColl 185 N 2D: the loop 0.89×), and lets a 3D line contact go stacked (MIRRORED_STACK_LIMIT; McColl
+  185 N 3D 0.64× its loop one by one).
 
 An implicit step (a cycle that anticipates s cycles of its own wear) solves the positions **coupled**
 (:func:`coupled_positions`): each position's gap at the step's end holds the wear the whole cycle deposits — the
