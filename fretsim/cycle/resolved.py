@@ -239,9 +239,9 @@ def _symmetric(member, normal, moving: np.ndarray, flat: np.ndarray, pairs: list
     """Whether a cycle's contact problem is symmetric along x at this state: the problem itself (the unworn gap,
     the grid and the normal operators: ``normal.mirror_tolerance``; the tangential compliance's kernel), the flat's
     wear and the moving body's gap at each pair of mirrored positions (with an implicit step's corrections), within
-    the mirror's tolerance.  Then the cycle is
-    too, once its up-stroke starts from its own end mirrored (:func:`positions`): the down-stroke is the up-stroke
-    mirrored, and so are their deposits (to round-off: the state's asymmetry does not grow)."""
+    the mirror's tolerance.  Then the cycle is too, once its up-stroke starts from its own end mirrored
+    (:func:`positions`): the down-stroke is the up-stroke mirrored, and so are their deposits (to round-off: the
+    state's asymmetry does not grow)."""
     find = getattr(normal, "mirror_tolerance", None)
     within = find(extra, float(p.max())) if find is not None else 0.0
     if not member.rigid:
