@@ -37,7 +37,7 @@ from fretsim.regrid import Coarsen
 from fretsim.solvers import solve
 from fretsim.stability import GrowthWatch, checkerboard_signed
 from fretsim.stepping import SCHEMES, relative_change
-from fretsim.stepping.implicit import DEPTH_SHARE
+from fretsim.stepping.implicit import DEPTH_SHARE, at_deepest
 
 __all__ = ["DEPTH_SHARE", "DomainError", "NumericalFailure", "Observer", "PhysicalLimit", "ResolutionError", "Setup",
            "SimulationError", "Step", "simulate", "summarize"]
@@ -188,7 +188,7 @@ class _Loop:
         self.d_prev = 1
         self.jump = 1.0
         self.lag = 0.0  # pressure lag per cycle of step (the last step's estimate / its length)
-        self.err_abs_m = self.err_abs_s = 0.0  # accumulated local depth errors (mm, L2)
+        self.err_abs_m = self.err_abs_s = 0.0  # accumulated local depth errors (mm, the largest element's)
         self.history: list = []  # implicit schemes: (N, φ_m, φ_s, p, φ_work, φ_energy)
         self.batch: list = []  # adaptive scheme: (wear m, wear s, work, energy) at the last linear steps
         self.watch = GrowthWatch()
@@ -257,7 +257,7 @@ class _Loop:
         step = _record(s, self.n, self.h_m, self.h_s, cyc, self.work, self.t0 - self.elapsed)
         step.energy = self.dissipated()
         step.jump, step.rejected = jump, self.rejected
-        step.error_depth = max(_rel_scalar(self.err_abs_m, self.h_m), _rel_scalar(self.err_abs_s, self.h_s))
+        step.error_depth = self.depth_error()
         step.error_pressure = error_pressure
         self.rejected = 0
         checks.check_invariant(step.archard_error, self.model.invariant, self.n)
@@ -310,10 +310,18 @@ class _Loop:
         self.cyc = self.cyc or self.restored_cycle()
         step = _record(self.s, self.n, self.h_m, self.h_s, self.cyc, self.work, self.t0 - self.elapsed)
         step.energy = self.dissipated()
-        step.error_depth = max(_rel_scalar(self.err_abs_m, self.h_m), _rel_scalar(self.err_abs_s, self.h_s))
+        step.error_depth = self.depth_error()
         step.block, step.limit, step.is_snapshot = self.block, self.reached, step.is_snapshot or bool(self.reached)
         step.state = checkpoint.state(self)
         return step
+
+    def depth_error(self) -> float:
+        """The stepping's estimate of the reported depths' relative error: each body's accumulated local errors
+        (absolute, at the element where they are largest, or the deepest one's under implicit steps) over its
+        deepest wear.  (Over the L2 norm of the whole depth field, as before, it was √(elements in contact) times
+        too small: McColl 185 N 3D, 100 cycles, estimated 3.2e-5 against an error of 7.8e-4 from the run cycle
+        by cycle.)"""
+        return max(_rel_scalar(self.err_abs_m, self.h_m), _rel_scalar(self.err_abs_s, self.h_s))
 
     def energy_rate(self, cyc: Cycle) -> float:
         """The cycle's dissipated energy as the rate the loop accumulates (N·mm); 0 for a cycle that knows none,
@@ -348,8 +356,11 @@ class _Loop:
         self.p_prev, self.d_prev = p_old, d_n
         # forward Euler with ΔN against the per-cycle update: local error ≈ ½(ΔN − 1)·ΔN·ṙ
         r2_m, r2_s = cyc.rate_moving, cyc.rate_stationary
-        self.err_abs_m += 0.5 * (d_n - 1) * float(np.linalg.norm(r2_m - r_m))
-        self.err_abs_s += 0.5 * (d_n - 1) * float(np.linalg.norm(r2_s - r_s))
+        # (at each body's deepest element in contact before and after, as the implicit schemes hold it: the
+        #  reported depth's; elements the contact front crossed carry the pressure lag's error instead)
+        inner = (p_old > 0) & (cyc.pressure > 0)
+        self.err_abs_m += 0.5 * (d_n - 1) * at_deepest((r2_m - r_m)[inner], self.h_m[inner])
+        self.err_abs_s += 0.5 * (d_n - 1) * at_deepest((r2_s - r_s)[inner], self.h_s[inner])
         return cyc, 0.5 * relative_change(cyc.pressure - p_old, cyc.pressure)
 
     def run(self, resume: Optional[dict] = None) -> Step:
@@ -374,8 +385,8 @@ class _Loop:
             return reached.step
 
 
-def _rel_scalar(err: float, h) -> float:
-    n = float(np.linalg.norm(h)) if isinstance(h, np.ndarray) else float(h)
+def _rel_scalar(err: float, h: np.ndarray) -> float:
+    n = float(np.abs(h).max()) if h.size else 0.0
     return err / n if n > 0 else 0.0
 
 

@@ -252,7 +252,10 @@ def test_the_grid_error_companions_coarsen_where_the_run_did():
     out = run(load_case(TUBE, ["limits.wall_loss=20 %"]), runs=SideRuns(announce=said.append))
     assert any("coarsened where the run was" in s for s in said)
     # its estimate is of the grids the run used: the run on them against the companion at twice their element
-    assert 0 < out.summary["estimated_error_width"] < 0.01
+    # (the grid's part, without the stepping's: the depths' stepping estimate, 0.39 % here, is added to the width's
+    #  total and is no measure of the companion)
+    grid_part = out.summary["estimated_error_width"] - out.summary["error_estimate_depth"]
+    assert 0 < grid_part < 0.01
     assert math.isfinite(out.summary["estimated_error_cycles_to_limit"])
 
 

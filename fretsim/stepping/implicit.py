@@ -161,7 +161,7 @@ def _local_errors(loop, partner, d, p_now, p_new, r_m, r_s, new_phi_m, new_phi_s
         inner = (p_now > 0) & (p_new > 0)
         r0_m, r0_s = loop.r_m, loop.r_s  # the rates at the current state, history[-1]
         e_m, e_s, k_order = 0.5 * d * (r_m - r0_m)[inner], 0.5 * d * (r_s - r0_s)[inner], 1
-    return _at_deepest(e_m, h_m[inner]), _at_deepest(e_s, h_s[inner]), k_order
+    return at_deepest(e_m, h_m[inner]), at_deepest(e_s, h_s[inner]), k_order
 
 
 def _predict(history: list, cycle: int) -> np.ndarray:
@@ -217,6 +217,6 @@ def _amax(a: np.ndarray) -> float:
     return float(np.abs(a).max()) if a.size else 0.0
 
 
-def _at_deepest(error: np.ndarray, depth: np.ndarray) -> float:
+def at_deepest(error: np.ndarray, depth: np.ndarray) -> float:
     """|error| at the deepest element (0 when there is none)."""
     return float(abs(error.ravel()[np.argmax(depth.ravel())])) if error.size else 0.0
