@@ -346,8 +346,8 @@ def coupled_positions(member, wear_moving, wear_stationary, normal, du: np.ndarr
     position k reads of it is the transpose of what it deposits (the hat kernel reads and receives by the same
     weights), so Ω times the coupled operator is symmetric and positive; the travels then follow the pressures as
     in :func:`positions`, and the pass's defect measures what the linearisation (each point's own slip, the
-    travels) missed.  ``start``: the last step's
-    pressures at every position."""
+    travels) missed.  ``start``: the last step's pressures at every position.  A symmetric cycle (:func:`positions`)
+    solves its up-stroke coupled by its wear and its mirror image's; the rest is mirrored, as in :func:`positions`."""
     coupled = getattr(normal, "coupled", None)
     m, shape = du.size, member.grid.shape
     if coupled is None or not getattr(normal, "stacks", True) or guess is None or \
@@ -355,8 +355,15 @@ def coupled_positions(member, wear_moving, wear_stationary, normal, du: np.ndarr
         return None
     # from the last step's positions where there is one (the turning positions' contacts are a third narrower
     # than mid-stroke's: from mid-stroke's pressure everywhere the coupled solve took 1.5 times the iterations)
-    p = start.copy() if start is not None and start.shape == (m,) + shape else np.repeat(guess[None], m, axis=0)
-    found = travels(member, p, du, budget=m // PARTIAL_SHARE)
+    started = start is not None and start.shape == (m,) + shape
+    p = start.copy() if started else np.repeat(guess[None], m, axis=0)
+    pairs = mirror_pairs(du)
+    turn = _turn(du, pairs) if pairs and _symmetric(member, normal, np.broadcast_to(wear_moving, (m,) + shape),
+                                                    wear_stationary, pairs, extra, p) else None
+    mirror = pairs if turn is not None else ()
+    if mirror:  # (from the warm start made symmetric, as positions() starts)
+        p = _mirrored(p if started else np.repeat(0.5 * (guess + guess[..., ::-1])[None], m, axis=0), mirror, turn)
+    found = travels(member, p, du, budget=m // PARTIAL_SHARE, mirror=mirror)
     if found is None:
         return None
     iterations = found[3]
@@ -364,28 +371,25 @@ def coupled_positions(member, wear_moving, wear_stationary, normal, du: np.ndarr
     b = a + found[1]
     flat = np.broadcast_to(wear_stationary, (m,) + shape)
     factor = member.law.gross_slip_factor(member.friction_coefficient)
-    idx, rest = np.flatnonzero(counted), np.flatnonzero(~counted)
+    idx = np.array([i for i, _ in mirror], int) if mirror else np.flatnonzero(counted)  # the positions solved
+    rest = np.array([], int) if mirror else np.flatnonzero(~counted)
     for _ in range(MAX_ROUNDS):
-        sweep = sweep_of(member, p, a, b - a, wear_stationary, counted)
+        sweep = sweep_of(member, p, a, b - a, wear_stationary, np.isin(np.arange(m), idx))
         seen = wear_moving + _read(member, flat, a, b, sweep)
-        couple = Coupling(member, sweep, factor * np.abs(b - a)[idx], (a[idx], b[idx]), step, extra, p[idx] > 0)
-        lag = np.zeros(p[idx].shape)
-        for _ in range(1 + OWN_SLIP_PASSES):  # each point's own slip, lagged (see Coupling)
-            got = coupled(seen[idx] + lag, p[idx], couple, extra, load=member.load, cycle=cycle)
-            if got is None:
-                return None
-            p[idx] = got[0]
-            iterations += sum(res.iterations for res in got[1])
-            lag, moved = couple.remainder(p[idx]), lag
-            if np.abs(lag - moved).max() <= OWN_SLIP_TOLERANCE * max(np.abs(couple(p[idx]) + extra(p[idx])).max(),
-                                                                    1e-300):
-                break
+        couple = Coupling(member, sweep, factor * np.abs(b - a)[idx], (a[idx], b[idx]), step, extra, p[idx] > 0,
+                          mirrored=bool(mirror))
+        got, lag, its = _coupled_solve(member, coupled, couple, seen[idx], p[idx], extra, cycle)
+        if got is None:
+            return None
+        p[idx] = got[0]
+        iterations += its
         results = [None] * m
         for i, res in zip(idx, got[1]):
             results[i] = res
-        r_m, r_s = couple.rates(p[idx], own=True)
-        grown = step * (r_m + _read(member, r_s, a[rest], b[rest])) if rest.size else None
+        grown = None
         if rest.size:  # the uncounted quarter deposits nothing: it reads the step's wear, solved on C alone
+            r_m, r_s = couple.rates(p[idx], own=True)
+            grown = step * (r_m + _read(member, r_s, a[rest], b[rest]))
             got = normal.rows(seen[rest] + grown, p[rest], None, load=member.load, cycle=cycle)
             if got is None:
                 return None
@@ -393,18 +397,49 @@ def coupled_positions(member, wear_moving, wear_stationary, normal, du: np.ndarr
             for i, res in zip(rest, got[1]):
                 results[i] = res
                 iterations += res.iterations
-        q, ds, stuck, its, s, redo = _went(member, p, du, a, b)
+        if mirror:
+            p = _mirrored(p, mirror, turn, results)
+        q, ds, stuck, its, s, redo = _went(member, p, du, a, b, mirror)
         iterations += its
         if not redo.any():
             if odd_even_run(p.reshape(-1, shape[-1])) >= ODD_EVEN_RUN:
                 return None  # (see ODD_EVEN_RUN: the corrected passes take this step)
             correction = np.empty((m,) + shape)
-            correction[idx] = couple(p[idx]) + lag
+            correction[idx] = couple(p[idx]) - extra(p[idx]) + lag
             if rest.size:
                 correction[rest] = grown - extra(p[rest])
+            if mirror:
+                correction = _mirrored(correction, mirror, turn)
             return (p, results, q, s, ds, stuck, iterations), list(correction)
         a, b = s, s + ds
     return None
+
+
+def _coupled_solve(member, coupled, couple, seen, pc, extra, cycle: int) -> tuple:
+    """The coupled positions' pressures and results (None: not solved here), with each point's own slip lagged
+    (:meth:`Coupling.remainder`) until it settles: (found, the lag, iterations)."""
+    lag, iterations, got = np.zeros(pc.shape), 0, None
+    for _ in range(1 + OWN_SLIP_PASSES):  # each point's own slip, lagged (see Coupling)
+        got = coupled(seen + lag, pc, couple, None, load=member.load, cycle=cycle)
+        if got is None:
+            return None, lag, iterations
+        pc = got[0]
+        iterations += sum(res.iterations for res in got[1])
+        lag, moved = couple.remainder(pc), lag
+        if np.abs(lag - moved).max() <= OWN_SLIP_TOLERANCE * max(np.abs(couple(pc)).max(), 1e-300):
+            break
+    return got, lag, iterations
+
+
+def _mirrored(stack: np.ndarray, mirror: list, turn: tuple, results: Optional[list] = None) -> np.ndarray:
+    """A symmetric cycle's stack (m, My, Mx) with its down-stroke the up-stroke mirrored along x and its quarter
+    the up-stroke's end mirrored (``results``: their ContactResults too, in place)."""
+    out = stack.copy()
+    for i, j in list(mirror) + [(turn[1], turn[0])]:
+        out[j] = stack[i][..., ::-1]
+        if results is not None:
+            results[j] = mirror_result(results[i])
+    return out
 
 
 class Coupling:
@@ -417,8 +452,11 @@ class Coupling:
     Woodbury with a 2 × 2 solve per mode.  With each layer's own inverse instead (C + s·W)⁻¹, the modes in which
     the positions differ were taken as stiff as those they share, and the iterations grew with the step (to 90)."""
 
-    def __init__(self, member, sweep, weight, travel: tuple, step: float, extra, on=None):
+    def __init__(self, member, sweep, weight, travel: tuple, step: float, extra, on=None, mirrored: bool = False):
         self.sweep, self.step, self.extra = sweep, step, extra
+        # (``mirrored``: the positions are a symmetric cycle's up-stroke, whose mirror image, the down-stroke,
+        #  deposits the mirror image of their wear: the step's wear is theirs and its mirror image)
+        self.mirrored = mirrored
         self.k_m, self.k_s = member.k_moving, member.k_stationary
         m = weight.shape[0]
         # each position's c·|ds| as most of its points in contact (``on``) have it, one value a position: with
@@ -433,38 +471,53 @@ class Coupling:
         self.own = weight  # each point's own c·|ds|: the wear the cycle tallies
         self.layer_weights = self.omega
         self.start, self.end = (np.median(x.reshape(m, -1), axis=1) for x in travel)
-        kernel = getattr(extra, "kernel", None)
-        self.diagonal = float(kernel.max()) if kernel is not None and np.count_nonzero(kernel) == 1 else None
 
     def rates(self, pc, own: bool = False):
         """The moving body's and the flat's wear per cycle from the counted positions' pressures ``pc``, each point
         by its position's slip ω_k (``own``: by its own)."""
         amount = (self.own if own else self.weight) * pc
-        return self.k_m * amount.sum(axis=0), self.k_s * self.sweep.deposit(amount).sum(axis=0)
+        return self._whole(self.k_m * amount.sum(axis=0)), self._whole(self.k_s * self.sweep.deposit(amount).sum(axis=0))
+
+    def _whole(self, rate):
+        """A wear rate of the positions solved, with their mirror images' where they are a symmetric cycle's half."""
+        return rate + rate[..., ::-1] if self.mirrored else rate
 
     def remainder(self, pc):
         """What each point's own slip adds to the step's wear that its position's ω_k leaves out, as each position
         reads it: a gap correction for the next coupled solve (a fixed point: the difference is small — the
         first increment past a reversal's points slide unevenly — so it settles in a pass or two)."""
         amount = (self.own - self.weight) * pc
-        r_m, r_s = self.k_m * amount.sum(axis=0), self.k_s * self.sweep.deposit(amount).sum(axis=0)
+        r_m, r_s = self._whole(self.k_m * amount.sum(axis=0)), self._whole(self.k_s * self.sweep.deposit(amount).sum(axis=0))
         return self.step * (r_m + self.sweep.read(np.broadcast_to(r_s, pc.shape)))
 
     def __call__(self, pc):
+        """The step's wear as each position reads it: the coupling, which the coupled solve adds to C alone (not
+        to C + s·W less s·W: two convolutions of the whole grid an iteration that cancelled, a fifth of a 3D run)."""
         r_m, r_s = self.rates(pc)
-        own = self.diagonal * pc if self.diagonal is not None else self.extra(pc)
-        return self.step * (r_m + self.sweep.read(np.broadcast_to(r_s, pc.shape))) - own
+        return self.step * (r_m + self.sweep.read(np.broadcast_to(r_s, pc.shape)))
 
     def preconditioner(self, win, rows: slice, cols: slice):
-        """An approximate inverse of C + s·(coupling) on the window operator ``win`` (C + s·W there)."""
-        c_hat = win.hat - (self.diagonal if self.diagonal is not None else self.extra.window(rows, cols).hat)
+        """An approximate inverse of C + s·(coupling) on the window operator ``win`` (C there).  Mirrored: the
+        inverse of the whole cycle's (the positions and their mirror images, each mirror image's transform had
+        from its position's by symmetry: no more transforms), its positions' part of what it gives; the window is
+        then symmetric about the grid's centre (solvers.rows.solve_coupled), so that mirroring in it is the
+        cycle's mirror."""
+        c_hat = win.hat
         c_hat = np.maximum(c_hat.real if np.iscomplexobj(c_hat) else c_hat, 1e-3 * float(np.abs(win.hat).max()))
         lx = win.fft_shape[1]
         xi = 2.0 * np.pi * np.arange(c_hat.shape[-1]) / (lx * win.grid.dx)
-        r = _read_symbol(xi, self.start, self.end, win.grid.dx)
-        w = self.omega[:, None]
+        m = self.omega.size
+        omega, start, end = self.omega, self.start, self.end
+        if self.mirrored:  # (a mirror image reads along its position's travel mirrored: −end → −start)
+            omega, start, end = np.tile(omega, 2), np.concatenate([start, -start]), np.concatenate([end, -end])
+            # the mirror image's transform, from its position's (real, nx wide, padded to lx): a phase times the
+            # conjugate at the opposite y frequency
+            turn = np.exp(-1j * xi * win.grid.dx * (win.grid.shape[1] - 1))
+            flip = (-np.arange(win.fft_shape[0])) % win.fft_shape[0]
+        r = _read_symbol(xi, start, end, win.grid.dx)
+        w = omega[:, None]
         s = self.step
-        g11 = c_hat + s * self.k_m * float(self.omega.sum())  # (the 2 × 2 system per mode: the same along y)
+        g11 = c_hat + s * self.k_m * float(omega.sum())  # (the 2 × 2 system per mode: the same along y)
         g12 = s * self.k_s * (w * r).sum(axis=0)
         g21 = s * self.k_m * (w * r.conj()).sum(axis=0)
         g22 = c_hat + s * self.k_s * (w * np.abs(r) ** 2).sum(axis=0)
@@ -476,12 +529,15 @@ class Coupling:
 
         def apply(v):
             vh = win.forward(v)  # (m, ly, modes)
+            if self.mirrored:
+                vh = np.concatenate([vh, turn * np.conj(vh[:, flip, :])])
             # (einsum, not tensordot: tensordot hands this small product to a multithreaded BLAS, whose threads
             #  woke for every call — 4-8 ms a call, 2.2x the whole 2D McColl 185 N run on two cores)
-            v1 = np.einsum("k,kyx->yx", self.omega, vh)
+            v1 = np.einsum("k,kyx->yx", omega, vh)
             v2 = np.einsum("kx,kyx->yx", wr, vh)
+            vh = vh[:m]
             vh -= (a11 * v1 + a12 * v2)[None]
-            vh -= r[:, None, :] * (a21 * v1 + a22 * v2)[None]
+            vh -= r[:m, None, :] * (a21 * v1 + a22 * v2)[None]
             vh *= inv_c
             return win.backward(vh)
         return apply

@@ -270,6 +270,8 @@ def solve_coupled(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float,
     on = p0 > 0
     if not on.any(axis=A).all() or (np.isnan(gaps) | np.isneginf(gaps)).any():
         return None
+    if getattr(couple, "mirrored", False):  # (a symmetric cycle's half: its preconditioner mirrors in the window)
+        on = on | on[..., ::-1]
     found, outgrew = _coupled_window(op, gaps, load, p0, tol, couple, on)
     if outgrew:  # (a load block's first step, from a contact a few elements wide): once more over the whole grid
         found, _ = _coupled_window(op, gaps, load, p0, tol, couple, np.ones(on.shape, bool))
