@@ -63,8 +63,9 @@ class FrettingCycle(Protocol):
     def describe(self) -> str:
         """The cycle model in a few words, for a run's one-paragraph summary."""
 
-    def passes(self, implicit: bool) -> int:
-        """Cycles solved per step (an implicit step's corrections re-solve it): for the cost estimate."""
+    def passes(self, implicit: bool) -> float:
+        """Cycles solved per step (an implicit step's corrections re-solve it; a coupled step costs as many): for
+        the cost estimate."""
 
     def stiffness(self):
         """An operator W (gap growth per cycle per unit pressure, on the solve grid) whose spectrum bounds the

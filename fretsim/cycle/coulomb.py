@@ -81,10 +81,11 @@ COUPLED = True  # a resolved implicit step solves its positions coupled by the s
 #                odd-even guard (resolved.ODD_EVEN_RUN) hands a step to the corrected passes; so do partial slip, solvers
 #                other than cg and refinement's coarse grid.  Off until 2026-11-27 because its short-run estimate
 #                under-stated the error: the stepping estimate's own fault (simulate._Loop.depth_error), corrected
-RESOLVED_PASSES = 1 + RESOLVED_CORRECTIONS  # the cost estimate's passes per resolved implicit step; a coupled step
-#                                             costs about as much over the run (its CG takes 2–4 times a pass's
-#                                             iterations, the run about 0.6 times the steps the estimate counts):
-#                                             McColl 185 N estimated 1.7 s (2D) and 58 s (3D), ran 1.3 s and 60 s
+RESOLVED_PASSES = 1 + RESOLVED_CORRECTIONS  # the cost estimate's passes per resolved implicit step, corrected
+COUPLED_PASSES = 2.7  # ... and what a coupled step costs in such passes over a run (its CG takes 2–4 times a pass's
+#                       iterations over half the positions where the cycle is symmetric, the run about 0.6 times the
+#                       steps the estimate counts): at 4, McColl 185 N was estimated at 1.42 s (2D) and 55 s (3D) and
+#                       ran 1.04 s and 33 s (2026-11-27)
 FATIGUE_SIDE_INCREMENTS = 1  # each elastic side of a fatigue state's cycle (not recorded): the flat's stresses
 #                              over the side move between its ends (the damage with 1, 2 and 12 alike to 1e-11 at
 #                              4, 10 and 25 µm on cases/ti_fretting_fatigue.yaml)
@@ -144,8 +145,8 @@ class CoulombCycle:
     def stiffness(self):
         return self._w_unit
 
-    def passes(self, implicit: bool) -> int:  # (mid-stroke's one correction is in the cost's calibration)
-        return RESOLVED_PASSES if implicit and self.resolved else 1
+    def passes(self, implicit: bool) -> float:  # (mid-stroke's one correction is in the cost's calibration)
+        return (COUPLED_PASSES if COUPLED else RESOLVED_PASSES) if implicit and self.resolved else 1
 
     def describe(self) -> str:
         return (f"{'uniform' if self.rigid else 'coulomb'} slip, stroke {'resolved' if self.resolved else 'mid-stroke'}, "
