@@ -419,3 +419,17 @@ def test_the_mirrored_preconditioner_is_the_whole_cycles_on_the_up_strokes_posit
     got = half.preconditioner(win, slice(None), window)(v)
     expected = whole.preconditioner(win, slice(None), window)(np.concatenate([v, v[..., ::-1]]))[:n]
     assert np.abs(got - expected).max() <= 1e-12 * np.abs(expected).max()
+
+
+def test_a_symmetric_cycles_coupled_step_under_a_load_history_solves_the_whole_cycle(coupled):
+    """Across load blocks the coupled step is not mirrored (resolved.COUPLED_MIRROR: the tube in service stopped
+    under it after a block change): over the same symmetric state as above, with the loop saying the run's load
+    changes (NormalSolve.one_load), the solve takes all 18 counted positions."""
+    member, grid, c, a = _member(0.025)
+    base = grid.x[None, :] ** 2 / (2 * RADIUS)
+    h_m, h_s, guess, memory = _worn_by_the_model(member, _ImplicitRows(c, base))
+    h_m, h_s = (0.5 * (h + h[..., ::-1]) for h in (h_m, h_s))
+    normal = _MirroredRows(c, base)
+    normal.solved, normal.one_load = [], False
+    member.solve(h_m, h_s, normal, guess, step=300.0, memory=memory, detail=False)
+    assert normal.solved and set(normal.solved) == {2 * member.increments}

@@ -75,17 +75,19 @@ RESOLVED_CORRECTIONS = 3  # ... every step of the resolved stroke that cannot be
 # its depth, with each step's corrections from none, was +0.25 % off the run cycle by cycle at 1 000 cycles against an
 # estimate of 0.17 %: every step corrects RESOLVED_CORRECTIONS times, +0.025 % against 0.031 %; tests/test_friction.py)
 COUPLED = True  # a resolved implicit step solves its positions coupled by the step's wear (resolved.coupled_positions),
-#                a symmetric cycle its up-stroke only (the down-stroke mirrored): McColl 185 N 2D 1.1 s against the
-#                corrected passes' 2.2 s, 3D 35 s against 60 s, with a stepping estimate of 0.26 % against 1.6 % (2D;
-#                0.28 % against 1.8 % in 3D: the corrected passes' defect, from their bound, is most of theirs).  Its
-#                odd-even guard (resolved.ODD_EVEN_RUN) hands a step to the corrected passes; so do partial slip, solvers
-#                other than cg and refinement's coarse grid.  Off until 2026-11-27 because its short-run estimate
+#                a symmetric cycle under one load its up-stroke only (the down-stroke mirrored: resolved.COUPLED_MIRROR):
+#                McColl 185 N 2D 1.06 s against the corrected passes' 2.2 s, 3D 32–35 s against 54–60 s, with stepping
+#                estimates of 0.26 % (2D) and 0.28 % (3D) where the corrected passes' defect, from their bound, makes
+#                theirs 1.6 % and 1.8 %, over model.accuracy (the tube in service: 3.0 % against 86 %).  Its odd-even
+#                guard (resolved.ODD_EVEN_RUN) hands a step to the corrected passes; so do partial slip, solvers other
+#                than cg and refinement's coarse grid.  Off until 2026-11-27 because its short-run estimate
 #                under-stated the error: the stepping estimate's own fault (simulate._Loop.depth_error), corrected
 RESOLVED_PASSES = 1 + RESOLVED_CORRECTIONS  # the cost estimate's passes per resolved implicit step, corrected
 COUPLED_PASSES = 2.7  # ... and what a coupled step costs in such passes over a run (its CG takes 2–4 times a pass's
-#                       iterations over half the positions where the cycle is symmetric, the run about 0.6 times the
-#                       steps the estimate counts): at 4, McColl 185 N was estimated at 1.42 s (2D) and 55 s (3D) and
-#                       ran 1.04 s and 33 s (2026-11-27)
+#                       iterations over the up-stroke's positions where the cycle is symmetric, the run about 0.6 times
+#                       the steps the estimate counts): at 4, McColl 185 N was estimated at 1.42 s (2D) and 55 s (3D)
+#                       and ran 1.04 s and 33 s (2026-11-27); across load blocks, where the step is not mirrored
+#                       (resolved.COUPLED_MIRROR), about 4: the estimate is then about 1.5× low
 FATIGUE_SIDE_INCREMENTS = 1  # each elastic side of a fatigue state's cycle (not recorded): the flat's stresses
 #                              over the side move between its ends (the damage with 1, 2 and 12 alike to 1e-11 at
 #                              4, 10 and 25 µm on cases/ti_fretting_fatigue.yaml)

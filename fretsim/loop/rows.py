@@ -26,6 +26,12 @@ class NormalSolve:
         self._summed = (None, None, None)
         self._symmetric = (None, False)
 
+    @property
+    def one_load(self) -> bool:
+        """Whether the run applies one load throughout, no load block changing to another (a symmetric cycle's
+        coupled step is mirrored only then: resolved.COUPLED_MIRROR)."""
+        return not self.loop.s.loading.boundaries
+
     def mirror_tolerance(self, extra, peak: float) -> float:
         """How far (mm) a worn gap may be from its mirror image and its contact still be taken as the mirrored one
         (:func:`fretsim.solvers.rows.mirror_tolerance`); 0 where the problem itself is not symmetric along x
