@@ -128,7 +128,7 @@ def _coupling_at_a_worn_state(step=2000.0):
     idx = np.flatnonzero(counted)
     extra = scaled(member.stiffness(), step)
     k = Coupling(member, sweep_of(member, p, a0, ds, wear_s, counted), np.abs(ds)[idx], (a0[idx], (a0 + ds)[idx]),
-                 step, extra, p[idx] > 0)
+                 step, p[idx] > 0)
     return k, c, extra, (p0 > 0)[0], len(idx), np.abs(ds)[idx]
 
 
@@ -403,11 +403,10 @@ def test_the_mirrored_preconditioner_is_the_whole_cycles_on_the_up_strokes_posit
     a0 = starts(ds)
     up, down = np.arange(1, n + 1), np.arange(n + 1, 2 * n + 1)
     assert np.allclose(a0[down], -a0[up][..., ::-1], atol=1e-15) and np.allclose(ds[down], -ds[up][..., ::-1])
-    extra = scaled(member.stiffness(), 2000.0)
 
     def coupling(idx, mirrored):
         sweep = sweep_of(member, p, a0, ds, wear_s, np.isin(np.arange(du.size), idx))
-        return Coupling(member, sweep, np.abs(ds)[idx], (a0[idx], (a0 + ds)[idx]), 2000.0, extra, p[idx] > 0,
+        return Coupling(member, sweep, np.abs(ds)[idx], (a0[idx], (a0 + ds)[idx]), 2000.0, p[idx] > 0,
                         mirrored=mirrored)
     half, whole = coupling(up, True), coupling(np.concatenate([up, down]), False)
     on = (p0 > 0)[0]

@@ -384,7 +384,7 @@ def coupled_positions(member, wear_moving, wear_stationary, normal, du: np.ndarr
     for _ in range(MAX_ROUNDS):
         sweep = sweep_of(member, p, a, b - a, wear_stationary, np.isin(np.arange(m), idx))
         seen = wear_moving + _read(member, flat, a, b, sweep)
-        couple = Coupling(member, sweep, factor * np.abs(b - a)[idx], (a[idx], b[idx]), step, extra, p[idx] > 0,
+        couple = Coupling(member, sweep, factor * np.abs(b - a)[idx], (a[idx], b[idx]), step, p[idx] > 0,
                           mirrored=bool(mirror))
         got, lag, its = _coupled_solve(member, coupled, couple, seen[idx], p[idx], extra, cycle)
         if got is None:
@@ -460,8 +460,8 @@ class Coupling:
     Woodbury with a 2 × 2 solve per mode.  With each layer's own inverse instead (C + s·W)⁻¹, the modes in which
     the positions differ were taken as stiff as those they share, and the iterations grew with the step (to 90)."""
 
-    def __init__(self, member, sweep, weight, travel: tuple, step: float, extra, on=None, mirrored: bool = False):
-        self.sweep, self.step, self.extra = sweep, step, extra
+    def __init__(self, member, sweep, weight, travel: tuple, step: float, on=None, mirrored: bool = False):
+        self.sweep, self.step = sweep, step
         # (``mirrored``: the positions are a symmetric cycle's up-stroke, whose mirror image, the down-stroke,
         #  deposits the mirror image of their wear: the step's wear is theirs and its mirror image)
         self.mirrored = mirrored
