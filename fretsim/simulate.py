@@ -37,7 +37,7 @@ from fretsim.regrid import Coarsen
 from fretsim.solvers import solve
 from fretsim.stability import GrowthWatch, checkerboard_signed
 from fretsim.stepping import SCHEMES, relative_change
-from fretsim.stepping.implicit import DEPTH_SHARE, at_deepest
+from fretsim.stepping.implicit import DEPTH_SHARE, at_deepest, relative_to_deepest
 
 __all__ = ["DEPTH_SHARE", "DomainError", "NumericalFailure", "Observer", "PhysicalLimit", "ResolutionError", "Setup",
            "SimulationError", "Step", "simulate", "summarize"]
@@ -321,7 +321,7 @@ class _Loop:
         deepest wear.  (Over the L2 norm of the whole depth field, as before, it was √(elements in contact) times
         too small: McColl 185 N 3D, 100 cycles, estimated 3.2e-5 against an error of 7.8e-4 from the run cycle
         by cycle.)"""
-        return max(_rel_scalar(self.err_abs_m, self.h_m), _rel_scalar(self.err_abs_s, self.h_s))
+        return max(relative_to_deepest(self.err_abs_m, self.h_m), relative_to_deepest(self.err_abs_s, self.h_s))
 
     def energy_rate(self, cyc: Cycle) -> float:
         """The cycle's dissipated energy as the rate the loop accumulates (N·mm); 0 for a cycle that knows none,
@@ -383,11 +383,6 @@ class _Loop:
             return s.stepper.run(self) or step
         except Reached as reached:
             return reached.step
-
-
-def _rel_scalar(err: float, h: np.ndarray) -> float:
-    n = float(np.abs(h).max()) if h.size else 0.0
-    return err / n if n > 0 else 0.0
 
 
 def _record(setup: Setup, cycle: int, h_m, h_s, cyc: Cycle, work: float, t0) -> Step:

@@ -127,7 +127,7 @@ def _accept(loop, cyc, d: int, partner: Optional[int], base: tuple, g: float, ha
     err_m, err_s, k_order = _local_errors(loop, partner, d, p_now, p_new, r_m, r_s, new_phi_m, new_phi_s, h_m, h_s)
     # a non-linear cycle: what its linearised implicit solve got wrong, counted in both bodies' errors
     err_m, err_s = err_m + cyc.defect, err_s + cyc.defect
-    error = max(_rel_scalar(err_m, _amax(h_m)), _rel_scalar(err_s, _amax(h_s))) / DEPTH_SHARE
+    error = max(relative_to_deepest(err_m, h_m), relative_to_deepest(err_s, h_s)) / DEPTH_SHARE
     if error > 1.5 * tol and d > 1:
         loop.rejected += 1
         loop.jump = next_step(d, error, tol, k_order)
@@ -208,8 +208,9 @@ def _exact_cycle(loop):
     return loop.emit(cyc, 1, e_p)
 
 
-def _rel_scalar(err: float, h) -> float:
-    n = float(np.linalg.norm(h)) if isinstance(h, np.ndarray) else float(h)
+def relative_to_deepest(err: float, h: np.ndarray) -> float:
+    """An absolute depth error (mm) over the deepest of the depths ``h`` (0 where there is no wear)."""
+    n = _amax(h)
     return err / n if n > 0 else 0.0
 
 
