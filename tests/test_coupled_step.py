@@ -420,6 +420,67 @@ def test_the_mirrored_preconditioner_is_the_whole_cycles_on_the_up_strokes_posit
     assert np.abs(got - expected).max() <= 1e-12 * np.abs(expected).max()
 
 
+def test_the_mirrored_preconditioner_is_the_whole_cycles_in_3d_where_the_images_come_from_the_opposite_y_frequency():
+    """In 3D a mirror image's transform is the position's conjugated at the opposite y frequency, and the
+    preconditioner forms its sums over the images from the positions' sums (not the images themselves): on a 3D
+    window (15 × 64, the half-space's kernel) with positions of different ω and travels, the mirrored
+    preconditioner equals the whole cycle's (positions and images as layers) on the stack and its mirror image,
+    to 1e-12 (round-off; without the y flip this fails, where the 2D test above cannot see it)."""
+    from fretsim.compliance import HalfSpace
+    from fretsim.grid import Grid
+    grid = Grid.centred(64, 15, 2e-3, 3e-3)
+    win = HalfSpace(grid, 115e3)
+    rng = np.random.default_rng(5)
+    m = 4
+
+    def coupling(omega, start, end, mirrored):
+        k = object.__new__(Coupling)  # (the preconditioner needs only these: no sweep, no member)
+        k.omega, k.start, k.end, k.mirrored = omega, start, end, mirrored
+        k.step, k.k_m, k.k_s = 3000.0, 2e-8, 3e-8
+        return k
+    omega = 0.01 + 0.04 * rng.random(m)
+    start = -0.01 + 0.02 * rng.random(m)
+    end = start + 0.004 * rng.random(m)
+    half = coupling(omega, start, end, True)
+    whole = coupling(np.tile(omega, 2), np.concatenate([start, -start]), np.concatenate([end, -end]), False)
+    v = rng.random((m,) + grid.shape)
+    got = half.preconditioner(win, slice(None), slice(None))(v)
+    expected = whole.preconditioner(win, slice(None), slice(None))(np.concatenate([v, v[..., ::-1]]))[:m]
+    assert np.abs(got - expected).max() <= 1e-12 * np.abs(expected).max()
+
+
+@pytest.mark.parametrize("mirrored", [False, True])
+def test_the_coupling_on_a_window_is_the_whole_grids_cut_to_it(mirrored):
+    """The coupled solve applies the coupling on the contact's window through one sparse matrix of the sweep's
+    shares (read R·f, deposit Rᵀ·a); on a stack that is zero outside the window it equals the coupling of the whole
+    grid cut to the window, to 1e-12 of its largest value (round-off: the same sums in another order), for the
+    whole cycle and for a symmetric cycle's up-stroke (its mirror image's wear added: left out of the flat's
+    share, the mirrored case fails)."""
+    member, grid, c, a, wear_m, wear_s = _state()
+    if mirrored:
+        wear_m, wear_s = (0.5 * (h + h[..., ::-1]) for h in (wear_m, wear_s))
+    path = increment_path(member.stroke, member.increments)
+    du = np.array([b - s for s, b, _ in path])
+    n = member.increments
+    p0 = solve(c, grid.x[None, :] ** 2 / (2 * RADIUS) + wear_m + wear_s, LOAD, tol=1e-10).pressure
+    p0 = 0.5 * (p0 + p0[..., ::-1]) if mirrored else p0
+    p = np.repeat(p0[None], du.size, axis=0)
+    pairs = resolved.mirror_pairs(du) if mirrored else None
+    ds = travels(member, p, du, mirror=pairs)[1] if mirrored else travels(member, p, du)[1]
+    a0 = starts(ds)
+    idx = np.arange(1, n + 1) if mirrored else np.arange(1, 2 * n + 1)
+    sweep = sweep_of(member, p, a0, ds, wear_s, np.isin(np.arange(du.size), idx))
+    k = Coupling(member, sweep, np.abs(ds)[idx], (a0[idx], (a0 + ds)[idx]), 2000.0, p[idx] > 0, mirrored=mirrored)
+    cols = slice(37, 251)  # (any window: here one off centre, across the contact's edge on the left)
+    shape = (idx.size,) + grid.shape
+    pw = np.random.default_rng(2).random((idx.size, 1, cols.stop - cols.start))
+    full = np.zeros(shape)
+    full[:, :, cols] = pw
+    expected = k(full)[:, :, cols]
+    got = k.window(slice(0, 1), cols, shape)(pw)
+    assert np.abs(got - expected).max() <= 1e-12 * np.abs(expected).max()
+
+
 def test_a_symmetric_cycles_coupled_step_under_a_load_history_solves_the_whole_cycle(coupled):
     """Across load blocks the coupled step is not mirrored (resolved.COUPLED_MIRROR: the tube in service stopped
     under it after a block change): over the same symmetric state as above, with the loop saying the run's load

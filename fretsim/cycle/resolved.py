@@ -504,6 +504,36 @@ class Coupling:
         r_m, r_s = self.rates(pc)
         return self.step * (r_m + self.sweep.read(np.broadcast_to(r_s, pc.shape)))
 
+    def window(self, rows: slice, cols: slice, shape: tuple):
+        """This coupling on the window (``rows``, ``cols``) of stacks ``shape`` (positions, My, Mx): what __call__
+        gives on a stack that is zero outside the window, cut to it.  The sweep's shares between the window's
+        elements and the flat as one sparse matrix R, built once a solve: the read is R·f and the deposit Rᵀ·a
+        (the same shares: the hat kernel reads and receives alike), where scattering by bincount over the whole
+        grid's stack was a fifth of a 3D run."""
+        import scipy.sparse as sparse  # (only here: `fretsim check` and the other cycles need none)
+        m, ny, nx = shape
+        (r0, r1, _), (c0, c1, _) = rows.indices(ny), cols.indices(nx)
+        wy, wx = r1 - r0, c1 - c0
+        sw = self.sweep
+        k, rest = np.divmod(sw._from, ny * nx)
+        y, x = np.divmod(rest, nx)
+        keep = (y >= r0) & (y < r1) & (x >= c0) & (x < c1)
+        element = ((k * wy + y - r0) * wx + x - c0)[keep]
+        read = sparse.csr_matrix((sw._share[keep], (element, (sw._flat % (ny * nx))[keep])), shape=(m * wy * wx, ny * nx))
+        deposit = read.T.tocsr()
+        omega = self.omega[:, None, None]
+
+        def couple(pc):
+            amount = omega * pc
+            r_m = np.zeros((ny, nx))
+            r_m[r0:r1, c0:c1] = self.k_m * amount.sum(axis=0)
+            r_s = self.k_s * (deposit @ amount.ravel())
+            out = (read @ self._whole(r_s.reshape(ny, nx)).ravel()).reshape(pc.shape)
+            out += self._whole(r_m)[r0:r1, c0:c1]
+            out *= self.step
+            return out
+        return couple
+
     def preconditioner(self, win, rows: slice, cols: slice):
         """An approximate inverse of C + s·(coupling) on the window operator ``win`` (C there).  Mirrored: the
         inverse of the whole cycle's (the positions and their mirror images, each mirror image's transform had
@@ -537,15 +567,21 @@ class Coupling:
 
         def apply(v):
             vh = win.forward(v)  # (m, ly, modes)
-            if self.mirrored:
-                vh = np.concatenate([vh, turn * np.conj(vh[:, flip, :])])
             # (einsum, not tensordot: tensordot hands this small product to a multithreaded BLAS, whose threads
             #  woke for every call — 4-8 ms a call, 2.2x the whole 2D McColl 185 N run on two cores)
-            v1 = np.einsum("k,kyx->yx", omega, vh)
-            v2 = np.einsum("kx,kyx->yx", wr, vh)
-            vh = vh[:m]
-            vh -= (a11 * v1 + a12 * v2)[None]
-            vh -= r[:m, None, :] * (a21 * v1 + a22 * v2)[None]
+            v1 = np.einsum("k,kyx->yx", omega[:m], vh)
+            v2 = np.einsum("kx,kyx->yx", wr[:m], vh)
+            if self.mirrored:  # the mirror images' sums from the positions': image k is turn·conj(vh_k) at the
+                #                opposite y frequency, its ω_k the same and its read symbol conj(r_k), so each sum
+                #                over the images is turn·conj(the positions' sum at −η) — not 2m layers formed
+                v1 = v1 + turn * np.conj(v1[flip])
+                v2 = v2 + turn * np.conj(v2[flip])
+            x1 = a11 * v1
+            x1 += a12 * v2
+            x2 = a21 * v1
+            x2 += a22 * v2
+            vh -= x1
+            vh -= r[:m, None, :] * x2
             vh *= inv_c
             return win.backward(vh)
         return apply
