@@ -206,6 +206,11 @@ class Sweep:
         moving = np.arange(ny * nx).reshape(ny, nx)[:, c0:c1]
         self._from = np.broadcast_to(moving, target.shape)[inside]  # the moving body's
 
+    def entries(self) -> tuple:
+        """(moving element, flat element, share) of every share, flattened indices: the sweep as the triplets of a
+        sparse matrix (a resolved implicit step's coupling applies it so, fretsim.cycle.resolved.Coupling.window)."""
+        return self._from, self._flat, self._share
+
     def deposit(self, amount: np.ndarray) -> np.ndarray:
         out = np.bincount(self._flat, weights=amount.ravel()[self._from] * self._share, minlength=amount.size)
         return out.reshape(self.shape)

@@ -514,12 +514,12 @@ class Coupling:
         m, ny, nx = shape
         (r0, r1, _), (c0, c1, _) = rows.indices(ny), cols.indices(nx)
         wy, wx = r1 - r0, c1 - c0
-        sw = self.sweep
-        k, rest = np.divmod(sw._from, ny * nx)
+        moving, flat, share = self.sweep.entries()
+        k, rest = np.divmod(moving, ny * nx)
         y, x = np.divmod(rest, nx)
         keep = (y >= r0) & (y < r1) & (x >= c0) & (x < c1)
         element = ((k * wy + y - r0) * wx + x - c0)[keep]
-        read = sparse.csr_matrix((sw._share[keep], (element, (sw._flat % (ny * nx))[keep])), shape=(m * wy * wx, ny * nx))
+        read = sparse.csr_matrix((share[keep], (element, (flat % (ny * nx))[keep])), shape=(m * wy * wx, ny * nx))
         deposit = read.T.tocsr()
         omega = self.omega[:, None, None]
 

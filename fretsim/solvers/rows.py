@@ -286,12 +286,13 @@ def _coupled_window(op, gaps, load, p0, tol, couple, on) -> tuple:
     whole = rows.stop - rows.start == ny and cols.stop - cols.start == nx
     win = op if whole else op.window(rows, cols)
 
-    def couple_win(p):
-        full = np.zeros(gaps.shape)
-        full[:, rows, cols] = p
-        return couple(full)[:, rows, cols]
     if hasattr(couple, "window"):  # (the coupling's own, cut to the window: no whole-grid stacks an iteration)
         couple_win = couple.window(rows, cols, gaps.shape)
+    else:
+        def couple_win(p):
+            full = np.zeros(gaps.shape)
+            full[:, rows, cols] = p
+            return couple(full)[:, rows, cols]
 
     precond = couple.preconditioner(win, rows, cols) if hasattr(couple, "preconditioner") else _preconditioner(win)
     found = cg_coupled(win, gaps[:, rows, cols], load, p0[:, rows, cols], tol, couple_win, precond,
