@@ -243,5 +243,46 @@ def sweep_read(field: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float,
     if worn.size == 0:
         return np.zeros(field.shape)
     reach = int(np.ceil(max(np.abs(start).max(), np.abs(end).max()) / dx)) + 2
+    if kernel == "hat" and np.abs(end - start).max() > SUMS_TRAVEL * dx:
+        return _hat_read_by_sums(field, start / dx, end / dx)
     return Sweep(start, end, dx, kernel, slice(max(worn[0] - reach, 0), min(worn[-1] + reach + 1, nx))).read(field)
+
+
+SUMS_TRAVEL = 8  # elements: a hat read over longer travels goes by running sums (below; the shares cost their span
+#                 a point, the sums the same whatever it is: 30× faster over 50 elements, 1.4× over 3)
+
+
+def _hat_read_by_sums(field: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """sweep_read with the hat kernel, by the running integral of the field's linear interpolation (0 beyond the
+    grid): (F(j + b) − F(j + a))/(b − a), travels in elements.  The same operator as the shares' (each share is the
+    hat's integral over the travel), to round-off, in a few passes over the arrays whatever the travel's length;
+    the shares cost their span in elements a point — a resolved cycle's first quarter travels the half-stroke,
+    which on the wire rope's 0.5 µm elements made its read most of a 3D run."""
+    rows, nx = field.shape
+    g = np.zeros((rows, nx + 2))  # the field at nodes −1 … nx, 0 at the two beyond the grid
+    g[:, 1:-1] = field
+    c = np.zeros((rows, nx + 2))  # ∫ up to each node
+    np.cumsum(0.5 * (g[:, :-1] + g[:, 1:]), axis=1, out=c[:, 1:])
+    j = np.arange(nx, dtype=float)[None, :]
+
+    def integral(t):
+        t = np.clip(t + 1.0, 0.0, nx + 1.0)  # from node −1
+        k = np.minimum(np.floor(t).astype(int), nx)
+        f = t - k
+        g0 = np.take_along_axis(g, k, axis=1)
+        g1 = np.take_along_axis(g, np.minimum(k + 1, nx + 1), axis=1)
+        return np.take_along_axis(c, k, axis=1) + f * (g0 + 0.5 * f * (g1 - g0))
+
+    length = b - a
+    point = np.abs(length) < 1e-9
+    ta, tb = j + a, j + b
+    out = (integral(tb) - integral(ta)) / np.where(point, 1.0, length)
+    if point.any():  # (a point that does not travel reads the interpolation under it)
+        t = np.clip(ta + 1.0, 0.0, nx + 1.0)
+        k = np.minimum(np.floor(t).astype(int), nx)
+        f = t - k
+        g0 = np.take_along_axis(g, k, axis=1)
+        g1 = np.take_along_axis(g, np.minimum(k + 1, nx + 1), axis=1)
+        out = np.where(point, g0 + f * (g1 - g0), out)
+    return out
 
