@@ -25,6 +25,8 @@ from __future__ import annotations
 
 from functools import lru_cache
 
+from typing import Optional
+
 import numpy as np
 
 from fretsim.compliance import Convolution
@@ -200,22 +202,34 @@ class Sweep:
         self.shape = start.shape
         ny, nx = self.shape
         c0, c1, _ = cols.indices(nx)
+        # (long travels with the hat kernel go by running sums: the shares cost their span a point)
+        self.sums = kernel == "hat" and c1 > c0 and float(np.abs(end - start).max()) > SUMS_TRAVEL * dx
+        if self.sums:
+            self._hat = HatSums(start / dx, end / dx)
+            self._travels = np.zeros(self.shape, bool)
+            self._travels[:, c0:c1] = True
+            return
         target, share, inside = _sweep_shares(start[:, c0:c1], end[:, c0:c1], dx, kernel, nx, c0)
         self._flat = (np.arange(ny)[:, None] * nx + target)[inside]  # the flat elements, flattened
         self._share = share[inside]
         moving = np.arange(ny * nx).reshape(ny, nx)[:, c0:c1]
         self._from = np.broadcast_to(moving, target.shape)[inside]  # the moving body's
 
-    def entries(self) -> tuple:
+    def entries(self) -> Optional[tuple]:
         """(moving element, flat element, share) of every share, flattened indices: the sweep as the triplets of a
-        sparse matrix (a resolved implicit step's coupling applies it so, fretsim.cycle.resolved.Coupling.window)."""
-        return self._from, self._flat, self._share
+        sparse matrix (a resolved implicit step's coupling applies it so, fretsim.cycle.resolved.Coupling.window);
+        None for a sweep by running sums, which has no shares."""
+        return None if self.sums else (self._from, self._flat, self._share)
 
     def deposit(self, amount: np.ndarray) -> np.ndarray:
+        if self.sums:
+            return self._hat.deposit(np.where(self._travels, amount.reshape(self.shape), 0.0))
         out = np.bincount(self._flat, weights=amount.ravel()[self._from] * self._share, minlength=amount.size)
         return out.reshape(self.shape)
 
     def read(self, field: np.ndarray) -> np.ndarray:
+        if self.sums:
+            return np.where(self._travels, self._hat.read(field.reshape(self.shape)), 0.0)
         out = np.bincount(self._from, weights=field.ravel()[self._flat] * self._share, minlength=field.size)
         return out.reshape(self.shape)
 
@@ -243,46 +257,94 @@ def sweep_read(field: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float,
     if worn.size == 0:
         return np.zeros(field.shape)
     reach = int(np.ceil(max(np.abs(start).max(), np.abs(end).max()) / dx)) + 2
-    if kernel == "hat" and np.abs(end - start).max() > SUMS_TRAVEL * dx:
-        return _hat_read_by_sums(field, start / dx, end / dx)
     return Sweep(start, end, dx, kernel, slice(max(worn[0] - reach, 0), min(worn[-1] + reach + 1, nx))).read(field)
 
 
-SUMS_TRAVEL = 8  # elements: a hat read over longer travels goes by running sums (below; the shares cost their span
-#                 a point, the sums the same whatever it is: 30× faster over 50 elements, 1.4× over 3)
+SUMS_TRAVEL = 8  # elements: a hat sweep over longer travels reads and deposits by running sums (below; the shares
+#                 cost their span a point, the sums the same whatever it is: a read 30× faster over 50 elements)
+
+
+class HatSums:
+    """A sweep with the hat kernel by running sums, for long travels (each of ``rows`` × ``nx`` elements from
+    j + a to j + b, in elements): everything that depends on the travels alone is found once, as the shares are.
+
+    The read is (F(j + b) − F(j + a))/(b − a), F the running integral of the field's linear interpolation (0 beyond
+    the grid); the deposit its adjoint, element j's amount c_j/(b_j − a_j)·[H(j + b_j − i) − H(j + a_j − i)] at
+    node i, H the hat's integral (1 a node or more behind the end, 0 a node or more ahead): a count of the ends
+    ahead of each node by a cumulative sum, and the two nodes around each end by bincount.  The same operators as
+    the shares' to round-off, in a few passes over the arrays whatever the travels' length; the shares cost their
+    span a point — a resolved cycle's first quarter travels the half-stroke, and the wire rope's increments span
+    29 of its 0.5 µm elements.  A point that does not travel reads and leaves its amount by the hat's weights under
+    it."""
+
+    def __init__(self, a: np.ndarray, b: np.ndarray):
+        self.shape = rows, nx = a.shape
+        j = np.arange(nx, dtype=float)[None, :]
+        length = b - a
+        self.point = np.abs(length) < 1e-9
+        self.inv = np.where(self.point, 0.0, 1.0 / np.where(self.point, 1.0, length))
+        base = (np.arange(rows) * (nx + 2))[:, None]  # (each row's nodes −1 … nx as slots 0 … nx + 1, flattened)
+        self.ends = []  # per end: (slot of node k, slot of node k + 1, its fraction f, H(f), H(f − 1))
+        for t in (j + b, j + a, j + a):  # (the last: where a point reads and leaves its amount)
+            t = np.clip(t + 1.0, 0.0, nx + 1.0)  # from node −1
+            k = np.minimum(np.floor(t).astype(int), nx)
+            f = t - k
+            self.ends.append(((base + k).ravel(), (base + np.minimum(k + 1, nx + 1)).ravel(), f.ravel(),
+                              _hat_integral(f).ravel(), _hat_integral(f - 1.0).ravel()))
+        lo, hi = np.minimum(j + a, j + b), np.maximum(j + a, j + b)  # a travel's nodes: ⌊lo⌋ … ⌈hi⌉
+        cover = (np.arange(rows) * (nx + 3))[:, None]
+        self.first = (cover + np.clip(np.floor(lo), -1, nx + 1).astype(int) + 1).ravel()
+        self.last = (cover + np.clip(np.ceil(hi), -1, nx).astype(int) + 2).ravel()
+
+    def read(self, field: np.ndarray) -> np.ndarray:
+        rows, nx = self.shape
+        g = np.zeros((rows, nx + 2))  # the field at nodes −1 … nx, 0 at the two beyond the grid
+        g[:, 1:-1] = field
+        c = np.zeros((rows, nx + 2))  # ∫ up to each node
+        np.cumsum(0.5 * (g[:, :-1] + g[:, 1:]), axis=1, out=c[:, 1:])
+        g, c = g.ravel(), c.ravel()
+        values = []
+        for k0, k1, f, _, _ in self.ends:
+            g0, g1 = g[k0], g[k1]
+            values.append((c[k0] + f * (g0 + 0.5 * f * (g1 - g0)), g0 + f * (g1 - g0)))
+        out = (values[0][0] - values[1][0]) * self.inv.ravel()
+        if self.point.any():
+            out = np.where(self.point.ravel(), values[2][1], out)
+        return out.reshape(self.shape)
+
+    def deposit(self, amount: np.ndarray) -> np.ndarray:
+        rows, nx = self.shape
+        size = rows * (nx + 2)
+        w = (amount * self.inv).ravel()
+        (kb, kb1, _, hb0, hb1), (ka, ka1, _, ha0, ha1), (kp, kp1, fp, _, _) = self.ends
+        # an end over node k (slot k + 1) counts for the nodes before k (H = 1 there): a count from each slot on
+        ahead = np.bincount(kb, weights=w, minlength=size) - np.bincount(ka, weights=w, minlength=size)
+        near = np.bincount(np.concatenate([kb, kb1, ka, ka1]),
+                           weights=np.concatenate([w * hb0, w * hb1, -w * ha0, -w * ha1]), minlength=size)
+        if self.point.any():
+            wp = np.where(self.point, amount, 0.0).ravel()
+            near += np.bincount(np.concatenate([kp, kp1]), weights=np.concatenate([wp * (1.0 - fp), wp * fp]),
+                                minlength=size)
+        whole = np.cumsum(ahead.reshape(rows, nx + 2)[:, ::-1], axis=1)[:, ::-1]
+        out = whole[:, 2:] + near.reshape(rows, nx + 2)[:, 1:-1]
+        # the sums leave round-off (±1e-16 of the row's total) where nothing lands: zero there, exactly, from an
+        # integer count of the travels carrying anything over each node; no negative values from positive
+        # amounts (a flat's wear that an increment made negative stops the run: simulate's check)
+        live = amount.ravel() != 0.0
+        count = np.bincount(self.first[live], minlength=rows * (nx + 3)) - \
+            np.bincount(self.last[live], minlength=rows * (nx + 3))
+        covered = np.cumsum(count.reshape(rows, nx + 3), axis=1)[:, 1:nx + 1] > 0
+        out = np.where(covered, out, 0.0)
+        if (amount >= 0.0).all():
+            np.maximum(out, 0.0, out=out)
+        return out
 
 
 def _hat_read_by_sums(field: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """sweep_read with the hat kernel, by the running integral of the field's linear interpolation (0 beyond the
-    grid): (F(j + b) − F(j + a))/(b − a), travels in elements.  The same operator as the shares' (each share is the
-    hat's integral over the travel), to round-off, in a few passes over the arrays whatever the travel's length;
-    the shares cost their span in elements a point — a resolved cycle's first quarter travels the half-stroke,
-    which on the wire rope's 0.5 µm elements made its read most of a 3D run."""
-    rows, nx = field.shape
-    g = np.zeros((rows, nx + 2))  # the field at nodes −1 … nx, 0 at the two beyond the grid
-    g[:, 1:-1] = field
-    c = np.zeros((rows, nx + 2))  # ∫ up to each node
-    np.cumsum(0.5 * (g[:, :-1] + g[:, 1:]), axis=1, out=c[:, 1:])
-    j = np.arange(nx, dtype=float)[None, :]
+    """sweep_read with the hat kernel by running sums (:class:`HatSums`), travels in elements."""
+    return HatSums(a, b).read(field)
 
-    def integral(t):
-        t = np.clip(t + 1.0, 0.0, nx + 1.0)  # from node −1
-        k = np.minimum(np.floor(t).astype(int), nx)
-        f = t - k
-        g0 = np.take_along_axis(g, k, axis=1)
-        g1 = np.take_along_axis(g, np.minimum(k + 1, nx + 1), axis=1)
-        return np.take_along_axis(c, k, axis=1) + f * (g0 + 0.5 * f * (g1 - g0))
 
-    length = b - a
-    point = np.abs(length) < 1e-9
-    ta, tb = j + a, j + b
-    out = (integral(tb) - integral(ta)) / np.where(point, 1.0, length)
-    if point.any():  # (a point that does not travel reads the interpolation under it)
-        t = np.clip(ta + 1.0, 0.0, nx + 1.0)
-        k = np.minimum(np.floor(t).astype(int), nx)
-        f = t - k
-        g0 = np.take_along_axis(g, k, axis=1)
-        g1 = np.take_along_axis(g, np.minimum(k + 1, nx + 1), axis=1)
-        out = np.where(point, g0 + f * (g1 - g0), out)
-    return out
-
+def _hat_deposit_by_sums(amount: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """sweep_deposit with the hat kernel by running sums (:class:`HatSums`), travels in elements."""
+    return HatSums(a, b).deposit(amount)

@@ -43,25 +43,34 @@ def test_archard_depth_and_volume_follow_eqs_15_16():
 
 
 @pytest.mark.parametrize("reach", [3.0, 40.0])
-def test_the_hat_read_by_running_sums_is_the_shares_read(reach):
-    """A long travel's hat read goes by the running integral of the field's interpolation, not the shares (whose
-    cost grows with the travel's span): the same operator, so the two agree on random fields and travels — up and
-    down, points that stay put, travels that run off the grid's ends — to 1e-10 of the field's largest value
-    (measured 4e-13 and 2.3e-12: the running sums' round-off, ~1e-16 of a row's integral, ~40 here, divided by the
-    shortest travel, 1e-3 elements, is 4e-12).
-    ``sweep_read`` takes the sums beyond SUMS_TRAVEL elements and agrees with the shares there too."""
-    from fretsim.wear import SUMS_TRAVEL, Sweep, _hat_read_by_sums, sweep_read
+def test_the_hat_sweep_by_running_sums_reads_and_deposits_as_the_shares_do(reach, monkeypatch):
+    """Long travels' hat sweeps read and deposit by running sums, not the shares (whose cost grows with the
+    travel's span): the same operators, so on random fields, amounts and travels — up and down, points that stay
+    put, travels of a thousandth of an element, travels that run off the grid's ends — the read and the deposit
+    agree with the shares' to 1e-10 of the largest value (measured 4e-12 and 2e-12: the running sums' round-off,
+    ~1e-16 of a row's integral, divided by the shortest travel, 1e-3 elements), the deposit is exactly zero where
+    the shares' is (nothing landed: the round-off there is removed) and never negative, and it is the read's
+    adjoint to round-off."""
+    from fretsim import wear
+    from fretsim.wear import HatSums, Sweep
+    monkeypatch.setattr(wear, "SUMS_TRAVEL", 1e9)  # (the reference: the shares whatever the travel)
     rng = np.random.default_rng(11)
     rows, nx, dx = 7, 120, 2e-3
     field = np.zeros((rows, nx))
     field[:, 20:100] = rng.random((rows, 80))
+    amount = np.zeros((rows, nx))
+    amount[:, 40:70] = rng.random((rows, 30))
     a = rng.uniform(-reach, reach, (rows, nx)) * dx
     b = a + rng.uniform(-reach, reach, (rows, nx)) * dx
-    b[0, :6] = a[0, :6]  # points that do not travel
-    b[1, :6] = a[1, :6] + 1e-3 * dx  # and travels of a thousandth of an element
-    a[2, :10], b[2, :10] = -1.5 * reach * dx, -0.5 * reach * dx  # off the left end
-    expected = Sweep(a, b, dx, "hat").read(field)
-    got = _hat_read_by_sums(field, a / dx, b / dx)
-    assert np.abs(got - expected).max() <= 1e-10 * field.max()
-    assert (reach > SUMS_TRAVEL) == (np.abs(b - a).max() > SUMS_TRAVEL * dx)
-    assert np.abs(sweep_read(field, a, b, dx, "hat") - expected).max() <= 1e-10 * field.max()
+    b[0, :] = a[0, :]  # points that do not travel
+    b[1, 40:46] = a[1, 40:46] + 1e-3 * dx  # and travels of a thousandth of an element
+    a[2, :50], b[2, :50] = -1.5 * reach * dx, -0.5 * reach * dx  # off the left end
+    shares = Sweep(a, b, dx, "hat")
+    sums = HatSums(a / dx, b / dx)
+    assert np.abs(sums.read(field) - shares.read(field)).max() <= 1e-10 * field.max()
+    expected, got = shares.deposit(amount), sums.deposit(amount)
+    assert np.abs(got - expected).max() <= 1e-10 * expected.max()
+    assert ((got == 0.0) == (expected == 0.0)).all() and (got >= 0.0).all()
+    assert abs((got * field).sum() - (amount * sums.read(field)).sum()) <= 1e-12 * (got * field).sum()
+    monkeypatch.undo()  # beyond SUMS_TRAVEL elements a Sweep goes by the sums
+    assert Sweep(a, b, dx, "hat").sums == (reach > wear.SUMS_TRAVEL)

@@ -509,12 +509,15 @@ class Coupling:
         gives on a stack that is zero outside the window, cut to it.  The sweep's shares between the window's
         elements and the flat as one sparse matrix R, built once a solve: the read is R·f and the deposit Rᵀ·a
         (the same shares: the hat kernel reads and receives alike), where scattering by bincount over the whole
-        grid's stack was a fifth of a 3D run."""
+        grid's stack was a fifth of a 3D run.  None where the sweep goes by running sums (long travels)."""
+        entries = self.sweep.entries()
+        if entries is None:  # (a sweep by running sums, over long travels: the caller pads and cuts)
+            return None
         import scipy.sparse as sparse  # (only here: `fretsim check` and the other cycles need none)
         m, ny, nx = shape
         (r0, r1, _), (c0, c1, _) = rows.indices(ny), cols.indices(nx)
         wy, wx = r1 - r0, c1 - c0
-        moving, flat, share = self.sweep.entries()
+        moving, flat, share = entries
         k, rest = np.divmod(moving, ny * nx)
         y, x = np.divmod(rest, nx)
         keep = (y >= r0) & (y < r1) & (x >= c0) & (x < c1)

@@ -286,9 +286,9 @@ def _coupled_window(op, gaps, load, p0, tol, couple, on) -> tuple:
     whole = rows.stop - rows.start == ny and cols.stop - cols.start == nx
     win = op if whole else op.window(rows, cols)
 
-    if hasattr(couple, "window"):  # (the coupling's own, cut to the window: no whole-grid stacks an iteration)
-        couple_win = couple.window(rows, cols, gaps.shape)
-    else:
+    # (the coupling's own, cut to the window, where it has one: no whole-grid stacks an iteration)
+    couple_win = couple.window(rows, cols, gaps.shape) if hasattr(couple, "window") else None
+    if couple_win is None:
         def couple_win(p):
             full = np.zeros(gaps.shape)
             full[:, rows, cols] = p
