@@ -339,12 +339,3 @@ class HatSums:
             np.maximum(out, 0.0, out=out)
         return out
 
-
-def _hat_read_by_sums(field: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """sweep_read with the hat kernel by running sums (:class:`HatSums`), travels in elements."""
-    return HatSums(a, b).read(field)
-
-
-def _hat_deposit_by_sums(amount: np.ndarray, a: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """sweep_deposit with the hat kernel by running sums (:class:`HatSums`), travels in elements."""
-    return HatSums(a, b).deposit(amount)
