@@ -338,4 +338,3 @@ class HatSums:
         if (amount >= 0.0).all():
             np.maximum(out, 0.0, out=out)
         return out
-
