@@ -17,7 +17,7 @@ from typing import Callable, Optional
 
 import numpy as np
 
-from fretsim import grid_error, regrid
+from fretsim import grid_error, heap, regrid
 from fretsim.case import GEOMETRY_KEYS, Case, CaseError, parse_case
 from fretsim.plan import Plan, SideRuns, estimate_cost, prepare, restore
 from fretsim.plan.cycle import strip_compliances
@@ -134,6 +134,7 @@ def run(case: Case, output: Optional[str | Path] = None, *, overwrite: bool = Fa
     announces the runs made besides this one (auto's proxies, a pilot, the grid-error companions) and keeps
     the proxies for the next plan in its keeping.
     """
+    heap.keep_warm()
     runs = runs if runs is not None else SideRuns()
     setup, filled, plan = prepare(case, runs=runs)
     claim = None
@@ -176,6 +177,7 @@ def resume(output: str | Path, *, progress: Optional[Callable[[int], None]] = No
     The case is the one stored in the file, so the run continues exactly as it would have: the same steps,
     the same arrays.  The file is verified first (structure, shapes, checksums): a damaged one is refused.
     """
+    heap.keep_warm()
     runs = runs if runs is not None else SideRuns()
     path = Path(output)
     claim = _claim(path) if path.exists() else None
