@@ -11,7 +11,7 @@ import pytest
 from fretsim.compliance import add, scaled
 from fretsim.cycle import coulomb, resolved
 from fretsim.cycle.coulomb import increment_path
-from fretsim.cycle.resolved import Coupling, _read_symbol, starts, sweep_of, travels
+from fretsim.cycle.resolved import Coupling, _read_symbol, read_symbol_modes, starts, sweep_of, travels
 from fretsim.solvers import solve
 from fretsim.solvers.rows import solve_coupled, solve_mirrored_rows, solve_rows
 from fretsim.stability import odd_even_run
@@ -190,6 +190,20 @@ def test_the_read_symbol_is_what_sweep_read_does_to_a_fourier_mode():
             expected = _read_symbol(np.array([xi]), np.array([start]), np.array([end]), dx)[0, 0] * mode
             inner = slice(8, 248)
             assert np.abs(got[0, inner] - expected[0, inner]).max() < 1e-12
+
+
+def test_the_read_symbol_at_the_transforms_modes_is_the_general_one():
+    """The preconditioner's symbol by one transform a position (travels of either sign, a point travel, a travel
+    that starts left of element 0, and one longer than the padded length, whose elements wrap onto each other)
+    against the sum of exponentials at the same ξ, to 1e-12 of the weights' sum (1)."""
+    dx = 0.0016
+    start = np.array([0.3, -1.7, 1.25, -0.4, 2.0]) * dx
+    end = np.array([2.9, -4.2, 1.25, 30.6, -70.0]) * dx
+    for lx in (64, 90):
+        xi = 2.0 * np.pi * np.arange(lx // 2 + 1) / (lx * dx)
+        got, expected = read_symbol_modes(lx, start, end, dx), _read_symbol(xi, start, end, dx)
+        assert got.shape == expected.shape
+        assert np.abs(got - expected).max() < 1e-12
 
 
 class _ImplicitRows:
