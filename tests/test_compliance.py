@@ -38,6 +38,23 @@ def test_fft_operator_equals_dense_symmetric_matrix(grid):
     assert np.abs(op(p).ravel() - dense @ p.ravel()).max() <= ROUND_OFF * np.abs(dense @ p.ravel()).max()
 
 
+@pytest.mark.parametrize("shape", [(1, 300, True), (27, 121, False)])
+def test_a_few_elements_by_their_columns_equal_the_transform_and_many_are_left_to_it(shape):
+    """Convolution.of_few, the solver's update at a step's few clipped or admitted elements: a 9-layer stack with
+    elements at the grid's corners and edges (where a column is cut by the window) against the transform to
+    round-off; a stack with many is declined (None), so the caller transforms."""
+    ny, nx, plane = shape
+    op = HalfSpace(Grid.centred(nx, ny, 0.0016, 1.0 if plane else 0.05, plane_strain=plane), 1e5)
+    rng = np.random.default_rng(3)
+    p = np.zeros((9, ny, nx))
+    for k, j, i in ((0, 0, 0), (3, ny - 1, nx - 1), (8, ny // 2, 0), (4, 0, nx // 3), (4, ny - 1, 7)):
+        p[k, j, i] = rng.uniform(0.5, 2.0)
+    got, full = op.of_few(p), op(p)
+    assert got is not None
+    assert np.abs(got - full).max() <= ROUND_OFF * np.abs(full).max()
+    assert op.of_few(rng.random((9, ny, nx))) is None
+
+
 def test_3d_compliance_is_positive_definite():
     dense = HalfSpace(Grid.centred(12, 8, 0.01, 0.4), 1.1e5).dense()
     assert np.linalg.eigvalsh(dense).min() > 0

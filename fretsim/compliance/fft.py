@@ -63,11 +63,11 @@ def _direct():
     def forward(p: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
         ly, lx = shape
         *lead, ny, nx = p.shape
-        buf = np.zeros((*lead, ny, lx))
+        buf = np.zeros((*lead, ny, lx), dtype=p.dtype if p.dtype == np.float32 else float)
         buf[..., :nx] = p
         ph = pp.r2c(buf, (buf.ndim - 1,), True, 0, None, 1)
         if ly > 1:  # the padding rows are zero: x first on the My rows, then y on the padded length
-            full = np.zeros((*lead, ly, ph.shape[-1]), dtype=complex)
+            full = np.zeros((*lead, ly, ph.shape[-1]), dtype=ph.dtype)
             full[..., :ny, :] = ph
             ph = pp.c2c(full, (full.ndim - 2,), True, 0, full, 1)
         return ph

@@ -75,6 +75,7 @@ COUPLED_MIRROR = True  # a symmetric cycle's coupled step solves its up-stroke o
 #                        block's do, ODD_EVEN_RUN; why the mirror loses the unmirrored step's margin there, whose up-stroke
 #                        starts one increment from rest, is not established: scripts/results/resolved_stability_coupled.txt)
 COUPLED_LIMIT = 1_000_000  # elements of a whole stack beyond which an implicit step corrects pass by pass
+SINGLE = True
 OWN_SLIP_PASSES = 3  # coupled solves again with each point's own slip lagged (Coupling.remainder), at most
 OWN_SLIP_TOLERANCE = 1e-2  # ... until what it adds moves by less than this share of the step's largest wear.  What
 #                            is left unsolved stays in the step's correction (its defect sees it), and the results
@@ -572,9 +573,15 @@ class Coupling:
             s * self.k_s * g11 / det
         wr = w * r.conj()
         inv_c = 1.0 / c_hat
+        if SINGLE:
+            omega, wr, r, inv_c = omega.astype(np.float32), wr.astype(np.complex64), r.astype(np.complex64), \
+                inv_c.astype(np.float32)
+            a11, a12, a21, a22 = (x.astype(np.complex64) for x in (a11, a12, a21, a22))
+            if self.mirrored:
+                turn = turn.astype(np.complex64)
 
         def apply(v):
-            vh = win.forward(v)  # (m, ly, modes)
+            vh = win.forward(v.astype(np.float32) if SINGLE else v)  # (m, ly, modes)
             # (einsum, not tensordot: tensordot hands this small product to a multithreaded BLAS, whose threads
             #  woke for every call — 4-8 ms a call, 2.2x the whole 2D McColl 185 N run on two cores)
             v1 = np.einsum("k,kyx->yx", omega[:m], vh)
@@ -591,7 +598,7 @@ class Coupling:
             vh -= x1
             vh -= r[:m, None, :] * x2
             vh *= inv_c
-            return win.backward(vh)
+            return win.backward(vh).astype(float) if SINGLE else win.backward(vh)
         return apply
 
 

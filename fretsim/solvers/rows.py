@@ -195,7 +195,7 @@ def cg_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float):
         err = np.where(done, 0.0, err)
         p_old = p
         tau = np.where(still, 0.0, (g * t).sum(axis=A) / np.where(still, 1.0, denom))
-        p, clipped, scale = _steps(p_old, tau, t, g, penetrating, total)
+        p, clipped, scale, _ = _steps(p_old, tau, t, g, penetrating, total)
         for k in np.flatnonzero(still & pen):  # put pressure on the penetrating elements (rare)
             p[k] = _admit(p_old[k], g[k], penetrating[k], total)
         delta = np.where(pen, 0.0, 1.0)
@@ -228,7 +228,8 @@ def cg_rows(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float):
 
 def _steps(p_old, tau, t, g, penetrating, total):
     """Each row's step p − τt clipped to p ≥ 0, penetrating elements added, rescaled to the load (cg._step, row
-    by row: a step that lifted a row off entirely is halved for that row)."""
+    by row: a step that lifted a row off entirely is halved for that row): (pressures, which rows clipped, their
+    rescaling, the steps τ taken)."""
     tau = tau.copy()
     for _ in range(60):
         trial = p_old - tau[:, None, None] * t
@@ -241,7 +242,7 @@ def _steps(p_old, tau, t, g, penetrating, total):
             break
         tau = np.where(lifted, 0.5 * tau, tau)
     scale = total / p.sum(axis=A)
-    return p * scale[:, None, None], clipped, scale
+    return p * scale[:, None, None], clipped, scale, tau
 
 
 def _complementary_rows(u, h, p, allowed) -> np.ndarray:
@@ -372,11 +373,21 @@ def cg_coupled(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float, co
             u, c, delta = op(p), couple(p), 0.0
             continue
         tau = float((lw * g * t).sum()) / denom
-        p, clipped, scale = _steps(p_old, np.full(p.shape[0], tau), t, g, penetrating, total)
+        p, clipped, scale, taus = _steps(p_old, np.full(p.shape[0], tau), t, g, penetrating, total)
         delta = 0.0 if pen.any() else 1.0  # (a restart where elements enter: without, 1.7 times the iterations)
-        if clipped.any() or pen.any() or np.abs(scale - 1.0).max() > 1e-12 or it % RECOMPUTE_EVERY == 0:
+        if it % RECOMPUTE_EVERY == 0:
             u, c = op(p), couple(p)
-        else:  # (the step kept every layer's load: a layer's rescaling, which the coupling mixes, would not)
+        elif clipped.any() or pen.any() or np.abs(scale - 1.0).max() > 1e-12:
+            # the coupling mixes the layers' rescalings: again; C acts layer by layer, so its displacement is the
+            # step's, rescaled, plus what clipping and admitting changed at a few edge elements, by their columns
+            # where that is cheaper (most steps at a growing contact's edges: a 3D step's transform a time)
+            step = taus[:, None, None]
+            trial = p_old - step * t
+            few = op.of_few(np.clip(-trial, 0.0, None) + np.where(penetrating, -step * g, 0.0)) if hasattr(
+                op, "of_few") else None
+            u = op(p) if few is None else scale[:, None, None] * (u - step * r_op + few)
+            c = couple(p)
+        else:  # (the step kept every layer's load)
             u = u - tau * r_op
             c = c - tau * r_c
         change = float((np.abs(p - p_old).sum(axis=A) / total).max())
