@@ -529,17 +529,24 @@ class Coupling:
         keep = (y >= r0) & (y < r1) & (x >= c0) & (x < c1)
         element = ((k * wy + y - r0) * wx + x - c0)[keep]
         read = sparse.csr_matrix((share[keep], (element, (flat % (ny * nx))[keep])), shape=(m * wy * wx, ny * nx))
-        deposit = read.T.tocsr()
-        omega = self.omega[:, None, None]
+        # the constants folded in once: the deposit weighs position k's elements by k_s·ω_k, the read by the step
+        deposit = (read.T @ sparse.diags(np.repeat(self.k_s * self.omega, wy * wx))).tocsr()
+        read = (self.step * read).tocsr()
+        moving = self.step * self.k_m * self.omega
+        # (a mirror image's moving-body wear lands on the window's mirror image: the window itself where it is
+        #  symmetric about the grid's centre, as solve_coupled makes it)
+        inside = not self.mirrored or c0 + c1 == nx
 
         def couple(pc):
-            amount = omega * pc
-            r_m = np.zeros((ny, nx))
-            r_m[r0:r1, c0:c1] = self.k_m * amount.sum(axis=0)
-            r_s = self.k_s * (deposit @ amount.ravel())
-            out = (read @ self._whole(r_s.reshape(ny, nx)).ravel()).reshape(pc.shape)
-            out += self._whole(r_m)[r0:r1, c0:c1]
-            out *= self.step
+            r_s = deposit @ pc.reshape(-1)
+            out = (read @ (self._whole(r_s.reshape(ny, nx)).reshape(-1) if self.mirrored else r_s)).reshape(pc.shape)
+            r_m = np.einsum("k,kyx->yx", moving, pc)
+            if inside:
+                out += r_m + r_m[..., ::-1] if self.mirrored else r_m
+            else:
+                whole = np.zeros((ny, nx))
+                whole[r0:r1, c0:c1] = r_m
+                out += self._whole(whole)[r0:r1, c0:c1]
             return out
         return couple
 
