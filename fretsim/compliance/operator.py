@@ -115,7 +115,8 @@ class Convolution:
         layers = p.size // (ny * nx)
         # (the costs in the time of one element's add, measured on 9-layer windows of 27 × 395, 27 × 120 and
         #  1 × 300: a column FEW_COLUMN plus its My·Mx adds, the stack's scan and zeroing FEW_SCAN an element, the
-        #  transform FEW_TRANSFORM a padded point; direct sums pay up to ~270 elements in the first, ~19 in the last)
+        #  transform FEW_TRANSFORM a padded point; direct sums pay up to ~270 elements in the first, ~19 in the last:
+        #  scripts/bench_contact.py --few, scripts/results/bench_contact_few.txt)
         if FEW_SCAN * p.size + at.size * (FEW_COLUMN + ny * nx) > budget * FEW_TRANSFORM * layers * ly * lx:
             return None
         out = np.zeros(p.shape)
