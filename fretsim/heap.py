@@ -7,8 +7,7 @@ the kernel faults and zeroes each of them again: that stack's forward and backwa
 process, 2.4 ms from a warm heap, and whole McColl runs (uniform 3D, mid-stroke 2D and 3D) ran 5-7 % faster, the
 resolved 3D run no faster (its blocks stay in the heap anyway), peak memory the same (scripts/bench_heap.py).
 Serving blocks up to 32 MB from the heap and trimming only beyond 32 MB free keeps the pages; the process holds at
-most that much more than it uses.  Elsewhere than glibc (musl, macOS) nothing is
-changed: mallopt is glibc's.
+most that much more than it uses.  Elsewhere than glibc (musl, macOS) nothing is changed: mallopt is glibc's.
 """
 from __future__ import annotations
 
