@@ -30,6 +30,7 @@ def keep_warm() -> bool:
                 # (mallopt returns 1 on success; both are set: setting either one stops glibc adjusting the other,
                 #  and the trim threshold alone left blocks above 128 KB to mmap, slower than the default)
                 _done = bool(mallopt(M_MMAP_THRESHOLD, KEEP_BYTES)) and bool(mallopt(M_TRIM_THRESHOLD, KEEP_BYTES))
-        except (OSError, AttributeError):  # no C library to tune: the default heap, slower but the same numbers
+        except Exception:  # noqa: BLE001 - any failure to reach malloc (no _ctypes: ImportError; Windows'
+            #                    CDLL(None): TypeError) leaves the default heap: slower, the same numbers
             _done = False
     return _done

@@ -26,6 +26,23 @@ def test_the_heap_is_tuned_once_where_glibc_is():
     assert heap.keep_warm() is True  # (the second call changes nothing)
 
 
+@pytest.mark.parametrize("broken", ["no _ctypes", "CDLL(None) refused"])
+def test_a_process_without_a_reachable_malloc_keeps_its_heap_and_runs(broken, monkeypatch):
+    """Where ctypes is missing (a Python built without _ctypes: ImportError) or cannot open the process's own
+    library (Windows' CDLL(None): TypeError), nothing is tuned and nothing is raised: run() and resume() call
+    this first, and a failure here would stop every run."""
+    import ctypes
+    monkeypatch.setattr(heap, "_done", None)
+    if broken == "no _ctypes":
+        monkeypatch.setitem(sys.modules, "ctypes", None)
+    else:
+        def refuse(name, *a, **k):
+            raise TypeError("argument of type 'NoneType' is not iterable")
+        monkeypatch.setattr(ctypes, "CDLL", refuse)
+    assert heap.keep_warm() is False
+    assert heap.keep_warm() is False
+
+
 def test_a_run_gives_the_same_numbers_bit_for_bit_with_the_heap_kept_warm_or_not():
     """Where the blocks come from changes no arithmetic: the same depth, width, worn profile and pressure field to
     the last bit."""

@@ -82,9 +82,11 @@ OWN_SLIP_PASSES = 3  # coupled solves again with each point's own slip lagged (C
 OWN_SLIP_TOLERANCE = 1e-2  # ... until what it adds moves by less than this share of the step's largest wear.  What
 #                            is left unsolved stays in the step's correction (its defect sees it), and the results
 #                            do not feel it: against 1e-3, McColl 185/500/1670/500 N-10 µm 2D and 185 N 3D moved by
-#                            at most 8e-5 (relative) in depth, width and volume, and ran 12-34 % faster (a re-solve
-#                            is 5-24 iterations of nine positions); solving no lag at all moved them as little, but
-#                            the lag is what keeps a step past a reversal implicit in its points' own slip
+#                            at most 8e-5 (relative) in depth, width and volume, Kirk 20 Hz, S132 and the ball at
+#                            25 µm (2D, 20 000 cycles) by at most 2e-4 (Kirk's width), and ran 12-34 % faster (a
+#                            re-solve is 5-24 iterations of nine positions).  On all of them no step re-solved at
+#                            1e-2: solving no lag at all moved them as little, but the lag is what keeps a step past a
+#                            reversal implicit in its points' own slip where it is large
 ODD_EVEN_RUN = 12  # a coupled step whose positions' pressures alternate element by element over this many elements
 #                    (stability.odd_even_run) is taken by the corrected passes instead.  The positions read the flat
 #                    at fractions of an element (the hat), so wear a load block deposits can alternate in ways none of
