@@ -505,7 +505,7 @@ def _run_local(tasks: list, jobs: int, progress) -> list:
     pool = ProcessPoolExecutor(max_workers=max(1, min(jobs, len(tasks))), mp_context=ctx, initializer=_init_worker,
                                initargs=(os.getpid(),))
     try:
-        futures = [pool.submit(run_point, t) for t in tasks]
+        futures = _submit_held(pool, tasks)
         for f in as_completed(futures):
             r = f.result()
             results.append(r)
@@ -521,6 +521,21 @@ def _run_local(tasks: list, jobs: int, progress) -> list:
         raise
     pool.shutdown(wait=True)
     return results
+
+
+def _submit_held(pool, tasks: list) -> list:
+    """The points submitted with Ctrl-C held while the pool forks its workers (at the first submit): a SIGINT that
+    landed inside os.fork's at-fork hooks (logging's) was printed as "Exception ignored" with a traceback and lost —
+    the sweep ran on to the end (tests/test_fuzz_surfaces.py, a Ctrl-C half a second in).  Held, it arrives once
+    the forks are done, as a KeyboardInterrupt here, and the sweep stops as it does at any other moment."""
+    import threading
+    hold = hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if hold else None
+    try:
+        return [pool.submit(run_point, t) for t in tasks]
+    finally:
+        if hold:
+            signal.pthread_sigmask(signal.SIG_SETMASK, before)
 
 
 def _run_dask(tasks: list, address: str, progress) -> list:
