@@ -11,7 +11,7 @@ import pytest
 from fretsim.compliance import add, scaled
 from fretsim.cycle import coulomb, resolved
 from fretsim.cycle.coulomb import increment_path
-from fretsim.cycle.resolved import Coupling, _read_symbol, read_symbol_modes, starts, sweep_of, travels
+from fretsim.cycle.resolved import Coupling, _read_weights, read_symbol_modes, starts, sweep_of, travels
 from fretsim.solvers import solve
 from fretsim.solvers.rows import solve_coupled, solve_mirrored_rows, solve_rows
 from fretsim.stability import odd_even_run
@@ -172,6 +172,12 @@ def test_the_coupled_operator_is_positive_on_the_changes_that_keep_each_position
     sym = 0.5 * (omega * whole + (omega * whole).T)
     eig = np.linalg.eigvalsh(basis.T @ sym @ basis)
     assert eig.min() > 1e-6 * eig.max(), eig.min() / eig.max()
+
+
+def _read_symbol(xi: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float) -> np.ndarray:
+    """The read's symbol at any ξ, by its definition: Σ_j w_j·e^{iξ·j·dx} over the elements a travel reaches."""
+    j, w = _read_weights(start, end, dx)
+    return (w[..., None] * np.exp(1j * dx * j[..., None] * xi[None, None, :])).sum(axis=1)
 
 
 def test_the_read_symbol_is_what_sweep_read_does_to_a_fourier_mode():

@@ -626,17 +626,12 @@ def _read_weights(start: np.ndarray, end: np.ndarray, dx: float) -> tuple:
     return j, np.where(point[:, None], np.clip(1.0 - np.abs(a[:, None] - j), 0.0, None), averaged)
 
 
-def _read_symbol(xi: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float) -> np.ndarray:
-    """The Fourier symbol (positions, modes) of reading the flat along a travel from ``start`` to ``end`` (mm), as
-    :func:`fretsim.wear.sweep_read` reads it with the hat kernel: Σ_j w_j·e^{iξ·j·dx} over the elements j the
-    travel reaches (:func:`_read_weights`), at any ξ."""
-    j, w = _read_weights(start, end, dx)
-    return (w[..., None] * np.exp(1j * dx * j[..., None] * xi[None, None, :])).sum(axis=1)
-
-
 def read_symbol_modes(lx: int, start: np.ndarray, end: np.ndarray, dx: float) -> np.ndarray:
-    """:func:`_read_symbol` at the real transform's modes of a padded length ``lx`` (ξ = 2πk/(lx·dx), k ≤ lx/2):
-    e^{iξ·j·dx} is then e^{2πi·jk/lx}, so the symbol is the conjugate transform of the weights laid at j mod lx —
+    """The Fourier symbol (positions, modes) of reading the flat along a travel from ``start`` to ``end`` (mm), as
+    :func:`fretsim.wear.sweep_read` reads it with the hat kernel — Σ_j w_j·e^{iξ·j·dx} over the elements j the
+    travel reaches (:func:`_read_weights`) — at the real transform's modes of a padded length ``lx`` (ξ =
+    2πk/(lx·dx), k ≤ lx/2): e^{iξ·j·dx} is then e^{2πi·jk/lx}, so the symbol is the conjugate transform of the
+    weights laid at j mod lx —
     one transform a position, where the exponentials of every element and mode were a tenth of a 2D resolved run."""
     j, w = _read_weights(start, end, dx)
     laid = np.zeros((w.shape[0], lx))
