@@ -297,3 +297,61 @@ def test_the_largest_shear_taken_where_j2_allows_it_equals_the_eigenvalues_every
     st[3, 0, 0] = 1.0  # τxy = 1: J₂ = 1, Tresca 1
     st[0, 0, 1] = 1.9  # σxx = 1.9: J₂ = 1.9²/3 = 1.20, Tresca 0.95
     assert _largest_shear(st) == (pytest.approx(1.0, rel=1e-12), 0)
+
+
+@pytest.mark.parametrize("half, count", [(0.20, 7), (0.04, 5)])
+def test_a_long_historys_cone_keeps_only_entries_that_can_hold_an_extreme_and_finds_the_same_planes(monkeypatch, half,
+                                                                                                   count):
+    """A long slide's history (the seat on a rail: 89 entries a point) is pruned before each cone to the entries
+    whose value at the centre, widened by the most any plane of the cone can move it, reaches the extreme less its
+    own widening (swt._may_hold_extreme): the cone's values and planes are the dense ones to round-off.  Two
+    histories: a sphere's field slid past each point over 60 positions (physical), and random tensors (near-ties
+    everywhere: a margin too small by a tenth changes some point's plane)."""
+    from fretsim.fatigue import swt
+    x, dx, p, q = _sphere_states(n=30, a=0.1, extent=3.0, mu=0.5)
+    st = stress_history(p, q, dx, dx, np.array([0.005, 0.03]), NU)  # (6, 3 states, 2 depths, 30, 30)
+    rng = np.random.default_rng(7)
+    rows = st[:, 0, :, 12:18, :].reshape(6, -1, 30)  # a slide along x past the points of 12 rows
+    slid = np.stack([np.roll(rows, -j, axis=-1) for j in range(60 // 2)] + [np.roll(rows * -1.0, j, axis=-1)
+                                                                            for j in range(60 // 2)], axis=1)
+    physical = slid.reshape(6, 60, -1)[:, :, :300]
+    noise = rng.normal(size=(6, 64, 400)) * 300.0
+    for s in (physical, noise):
+        centre = rng.normal(size=(s.shape[2], 3))
+        centre /= np.linalg.norm(centre, axis=1, keepdims=True)
+        centre[:, 2] = np.abs(centre[:, 2])
+        monkeypatch.setattr(swt, "PRUNE_FROM", 10 ** 9)
+        dense, n_dense = swt._cone(s, centre, E, NU, half, count)
+        monkeypatch.setattr(swt, "PRUNE_FROM", 0)
+        pruned, n_pruned = swt._cone(s, centre, E, NU, half, count)
+        assert np.abs(pruned - dense).max() <= 1e-12 * np.abs(dense).max()
+        assert np.array_equal(n_pruned, n_dense)
+    local_kept = swt._may_hold_extreme(np.ascontiguousarray(physical.transpose(2, 1, 0)), math.atan(half * math.sqrt(2)),
+                                       E, NU)
+    assert local_kept.mean() < (0.9 if half > 0.1 else 0.5)  # (it prunes: not a test that passes by keeping all)
+
+
+@pytest.mark.parametrize("half", [0.20, 0.04])
+def test_the_prunings_margin_keeps_an_entry_that_overtakes_the_largest_only_at_the_cones_corner(half):
+    """The margin is the most a plane of the cone can move a normal stress ((λ₁ − λ₂)·sin θ, θ = atan(half·√2) at
+    the cone's corner): an entry B that starts 99 % of that below the largest (an isotropic A, which no plane
+    moves) and turns towards the corner as fast as a tensor can (a pure shear in the plane of the centre and the
+    corner, oriented for it) is the largest at the corner, and is kept.  A margin 2 % smaller drops it.  (C and D
+    hold the strain's extremes, so that B is kept for its stress alone.)"""
+    from fretsim.fatigue import swt
+    theta = math.atan(half * math.sqrt(2.0))
+    t = np.array([1.0, 1.0, 0.0]) / math.sqrt(2.0)
+    n0 = np.array([0.0, 0.0, 1.0])
+    a = 100.0
+    phi = 0.5 * (theta + math.pi / 2)  # the shear's axes: f(θ) − f(0) = 2a·sin θ
+    e1, e2 = math.cos(phi) * n0 + math.sin(phi) * t, -math.sin(phi) * n0 + math.cos(phi) * t
+    b = a * (np.outer(e1, e1) - np.outer(e2, e2)) + 10.0 * np.eye(3)
+    centre_b = float(n0 @ b @ n0)
+    iso = centre_b + 0.99 * 2 * a * math.sin(theta)
+    tensors = [iso * np.eye(3), b, np.diag([0.0, 0.0, -1e4]), np.diag([-1e4, -1e4, 0.0])]
+    local = np.array([[m[0, 0], m[1, 1], m[2, 2], m[0, 1], m[0, 2], m[1, 2]] for m in tensors])[None]  # (1, 4, 6)
+    corner = np.array([half, half, 1.0]) / math.sqrt(1 + 2 * half * half)
+    at_corner = [float(corner @ m @ corner) for m in tensors]
+    assert at_corner[1] > at_corner[0] == max(at_corner[0], at_corner[2], at_corner[3])  # B is the largest there
+    assert swt._may_hold_extreme(local, theta, E, NU)[0, 1]
+    assert not swt._may_hold_extreme(local, theta * 0.98, E, NU)[0, 1]
