@@ -581,7 +581,7 @@ def _coarse_rows(rows: np.ndarray, slides: dict, search: np.ndarray, normals: np
     k = len(n)
     nx = rows.shape[-1]
     wanted = np.unique(search // nx)
-    group = max(1, CHUNK // (nx * k))
+    group = max(1, COARSE_CHUNK // (nx * k))
     value_at, where_at = np.zeros(rows.shape[2] * nx), np.zeros(rows.shape[2] * nx, dtype=int)
     # in single precision: where a point's value stands (below the cones' share) it is within ~1e-7 of the peak of
     # double's, against its plane's few degrees from the optimum; every point the cones refine is evaluated again in
@@ -604,7 +604,9 @@ def _coarse_rows(rows: np.ndarray, slides: dict, search: np.ndarray, normals: np
     return value_at[search], n[where_at[search]]
 
 
-CONE_WORK = 160000  # points × history entries a cone takes at a time: its planes' values (×25-49) stay in the cache
+COARSE_CHUNK = 160_000  # the 3D first pass's points × normals a group of rows (float32: 0.6 MB a work array; at
+#                        40 000 a group was two rows of the ball's window and numpy's cost per call dominated: 12 %
+#                        of its replayed states)
 CHUNK = 40_000  # points × normals at a time: the work arrays stay in the cache (a quarter of the time of 4·10⁶)
 
 
