@@ -355,3 +355,31 @@ def test_the_prunings_margin_keeps_an_entry_that_overtakes_the_largest_only_at_t
     assert at_corner[1] > at_corner[0] == max(at_corner[0], at_corner[2], at_corner[3])  # B is the largest there
     assert swt._may_hold_extreme(local, theta, E, NU)[0, 1]
     assert not swt._may_hold_extreme(local, theta * 0.98, E, NU)[0, 1]
+
+
+def test_between_recorded_states_the_stresses_in_single_precision_leave_the_damage_rate_where_it_counts():
+    """A fatigue state between recorded states (the damage only) takes its stresses in single precision (half the
+    transforms' time); a recorded state's fields stay double.  Against the same state in double: the damage rate
+    1/N within 2e-6 (relative) wherever it is at least a tenth of the largest (single precision's 6e-8 raised to
+    the curve's power, ~5 here, and the 1° cones' choice), and nowhere more than 1e-4 of the largest (a point at the
+    search's thresholds, skipped or refined in one and not the other, moves by at most their share's damage)."""
+    from fretsim.fatigue import field3d
+    x, dx, p, q = _sphere_states(n=30, a=0.1, extent=3.0, mu=0.6)
+    travel = np.stack([np.full(p.shape[1:], d) for d in (-2 * dx, 0.0, 2 * dx)])
+    spec = _spec(history.depths(dx, 0.3), critical_distance=0.02)
+    cyc = _state(p, q, travel)
+    single = evaluate(spec, x, dx, E, cyc, full=False, y=x, dy=dx)
+    double_history = lambda *a, single=False: stress_history(*a)  # noqa: E731
+    original = field3d.stress_history
+    try:
+        field3d.stress_history = double_history
+        double = evaluate(spec, x, dx, E, cyc, full=False, y=x, dy=dx)
+    finally:
+        field3d.stress_history = original
+    rate = lambda life: np.where(np.isfinite(life), 1.0 / np.where(np.isfinite(life), life, 1.0), 0.0)  # noqa
+    r1, r0 = rate(single.life), rate(double.life)
+    assert r0.max() > 0
+    big = r0 >= 0.1 * r0.max()
+    assert np.abs(r1[big] / r0[big] - 1).max() < 2e-6
+    assert np.abs(r1 - r0).max() < 1e-4 * r0.max()
+    assert not np.array_equal(r1, r0)  # (the single-precision path was taken)

@@ -61,7 +61,7 @@ def fields_3d(spec, x: np.ndarray, dx: float, dy: float, youngs: float, traction
     rows, cols = _window(p_flat)
     if cols.stop <= cols.start:
         return Fields3D(swt, angle, azimuth, None, 0.0 if full else math.nan, 0.0, 0.0, 0.0)
-    st = stress_history(p_flat[:, rows, cols], q_flat[:, rows, cols], dx, dy, z[:layers], spec.poisson)
+    st = stress_history(p_flat[:, rows, cols], q_flat[:, rows, cols], dx, dy, z[:layers], spec.poisson, single=not full)
     plane = swt_search_3d(st, youngs, spec.poisson, skip=SKIP_3D if full else skip_between, full=full, slides=slid)
     swt[:layers, rows, cols] = plane.swt
     angle[:layers, rows, cols], azimuth[:layers, rows, cols] = plane_angles(plane.normal)

@@ -243,7 +243,7 @@ def _layer_hats(nx: int, ny: int, dx: float, dy: float, z: float, poisson: float
 
 
 def stress_history(pressure: np.ndarray, shear_x: np.ndarray, dx: float, dy: float, depths: np.ndarray,
-                   poisson: float) -> np.ndarray:
+                   poisson: float, single: bool = False) -> np.ndarray:
     """The six stresses at every (state, depth, y, x) under each state's pressure and shear along x (arrays (state,
     ny, nx) on a uniform grid): shape (6, state, depth, ny, nx) in :data:`COMPONENTS`' order.  The cycle's states
     at once: each depth's kernels are made (or found) once for all of them — a fatigue state's dozen states would
@@ -257,11 +257,14 @@ def stress_history(pressure: np.ndarray, shear_x: np.ndarray, dx: float, dy: flo
     shape = (fft.next_fast_len(2 * ny - 1, real=False), fft.next_fast_len(2 * nx - 1, real=True))
     # (the solver's transforms: x on the loaded rows only, and back y first, then x on the rows kept — irfft2 did x
     # on every padded row and cropped after, 2.5x the time)
-    p_hat = fft.forward(pressure, shape)[:, None]  # (state, 1, ly, lx')
-    q_hat = fft.forward(shear_x, shape)[:, None]
-    out = np.empty((6, states, depths.size, ny, nx))
+    real = np.float32 if single else np.float64
+    p_hat = fft.forward(pressure.astype(real), shape)[:, None]  # (state, 1, ly, lx')
+    q_hat = fft.forward(shear_x.astype(real), shape)[:, None]
+    out = np.empty((6, states, depths.size, ny, nx), dtype=real)
     for d, z in enumerate(depths):
         k = _layer_hats(nx, ny, float(dx), float(dy), float(z), float(poisson), shape)
+        if single:
+            k = k.astype(np.complex64)
         field = fft.backward(p_hat * k[0][None] + q_hat * k[1][None], shape, (ny, nx))  # (state, 6, ny, nx)
         out[:, :, d] = np.moveaxis(field, 1, 0)
     return out
