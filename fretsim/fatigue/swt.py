@@ -484,7 +484,7 @@ def swt_search_3d(history, youngs: float, poisson: float, skip: float = 0.0, ful
     coarse_normals = hemisphere_normals(COARSE_NORMALS)
     if skip > 0 and points:
         bound = _slid_bound(rows, slides, youngs, poisson).ravel()
-        pilot = np.argsort(bound)[::-1][:PILOT_POINTS]
+        pilot = np.argpartition(bound, -PILOT_POINTS)[-PILOT_POINTS:] if bound.size > PILOT_POINTS else np.arange(bound.size)
         peak = float(_best_over(_gathered(rows, slides, pilot), coarse_normals, youngs, poisson, CHUNK)[0].max(
             initial=0.0))
         search = np.flatnonzero(bound >= skip * peak) if peak > 0 else np.zeros(0, int)
@@ -672,13 +672,14 @@ def _may_hold_extreme(local: np.ndarray, theta: float, youngs: float, poisson: f
 
 
 _PAIRS = ((0, 0), (1, 1), (2, 2), (0, 1), (0, 2), (1, 2))  # the six components' indices, in _components' order
+_PAIR_INDEX = np.array(_PAIRS)
 
 
 def _turning(frame: np.ndarray) -> np.ndarray:
     """(point, 6, 6): the weights that turn a point's six stress components into those in its ``frame`` (rows: the
     new axes in x, y, z), σ' = σ @ W — σ'_ab = Σ R_ak·R_bl·σ_kl, each shear counted both ways."""
-    out = np.empty((frame.shape[0], 6, 6))
-    for j, (a, b) in enumerate(_PAIRS):
-        for i, (k, l) in enumerate(_PAIRS):
-            out[:, i, j] = frame[:, a, k] * frame[:, b, l] + (frame[:, a, l] * frame[:, b, k] if k != l else 0.0)
+    a, b = _PAIR_INDEX[:, 0][None, :], _PAIR_INDEX[:, 1][None, :]  # (1, 6): the new component j's axes
+    k, l = _PAIR_INDEX[:, 0][:, None], _PAIR_INDEX[:, 1][:, None]  # (6, 1): the old component i's
+    out = frame[:, a, k] * frame[:, b, l]  # (point, i, j)
+    out[:, 3:] += frame[:, a, l[3:]] * frame[:, b, k[3:]]  # (a shear's other half: k ≠ l)
     return out
