@@ -36,6 +36,33 @@ def test_stroke_average_conserves_the_load_and_widens_the_contact():
     assert avg.max() == pytest.approx(1.0)
 
 
+@pytest.mark.parametrize("dx, stroke", [(10.0, 25.0), (10.0, 27.0), (1.128e-3, 0.08), (3.0, 1.0), (0.7, 0.35),
+                                        (0.0016, 0.025)])
+def test_stroke_average_by_running_sums_is_the_weighted_sum_and_exactly_zero_beyond_the_reach(dx, stroke):
+    """The box of whole-covered elements by a difference of running sums, the partial ends added: the weighted sum
+    Σ w_k p_(i−k) taken term by term to 1e-13 of the peak (the running sums' round-off over a few hundred
+    elements), on one row and on 27; an element the stroke cannot reach from any loaded one exactly 0 (the contact's
+    extent, and the scar's, are read from where the averages are 0)."""
+    rng = np.random.default_rng(5)
+    w = stroke_weights(dx, stroke)
+    reach = (w.size - 1) // 2
+    for rows in (1, 27):
+        p = np.clip(rng.normal(size=(rows, 400)), 0.0, None)
+        p[:, :150] = 0.0
+        p[:, -150:] = 0.0
+        want = np.zeros_like(p)
+        for k in range(-reach, reach + 1):  # want[i] += w_k · p[i − k]
+            shifted = np.zeros_like(p)
+            if k >= 0:
+                shifted[:, k:] = p[:, :p.shape[1] - k]
+            else:
+                shifted[:, :k] = p[:, -k:]
+            want += w[reach + k] * shifted
+        got = stroke_average(p, dx, stroke)
+        assert np.abs(got - want).max() <= 1e-13 * want.max()
+        assert np.array_equal(got == 0.0, want == 0.0)
+
+
 def test_archard_depth_and_volume_follow_eqs_15_16():
     # k = 3e-8 1/MPa, p = 100 MPa, 1000 cycles of 4·25 µm: 3e-8 · 1000 · 0.1 mm · 100 = 3e-4 mm
     assert archard_depth(3e-8, np.array([100.0]), 1000, 0.025)[0] == pytest.approx(3e-4, rel=ROUND_OFF)

@@ -3,11 +3,12 @@
 The contact solver applies small convolutions thousands of times per run (a window of a few dozen elements
 around the contact), where scipy.fft's Python layer (argument checks, padding, backend dispatch) costs two to
 three times the transform itself.  scipy's own pocketfft binding, called directly, skips that layer.  It is a
-private module: at import the direct path is checked against the public API on a small transform and used
-only if it exists and agrees; otherwise the public functions are used.  Both give the same numbers.
+private module: at the first transform the direct path is checked against numpy's FFT on small transforms and
+used only if it exists and agrees; otherwise numpy's functions are used.  Both give the same numbers.
 
-scipy.fft is imported at the first transform, not with this module: `fretsim check` and `summary` need none,
-and the import is a third of a quick command's time.
+The binding is loaded at the first transform, not with this module (`fretsim check` and `summary` need none), and
+from its file, not through ``import scipy.fft``, whose package costs 0.2-0.3 s to import (scipy.special, the
+array-API layer) and gives nothing the solver uses.  numpy's FFT (pocketfft as well) checks it and stands in for it.
 """
 from __future__ import annotations
 
@@ -42,23 +43,44 @@ def next_fast_len(n: int, real: bool) -> int:
 
 
 def _public_forward(p: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
-    import scipy.fft as sfft
     ly, lx = shape
-    ph = sfft.rfft(p, n=lx, axis=-1, workers=1)
-    return sfft.fft(ph, n=ly, axis=-2, workers=1) if ly > 1 else ph
+    ph = np.fft.rfft(p, n=lx, axis=-1)
+    return np.fft.fft(ph, n=ly, axis=-2) if ly > 1 else ph
 
 
 def _public_backward(ph: np.ndarray, shape: tuple[int, int], out_shape: tuple[int, int]) -> np.ndarray:
-    import scipy.fft as sfft
     ny, nx = out_shape
     ly, lx = shape
     if ly > 1:
-        ph = sfft.ifft(ph, axis=-2, workers=1)[..., :ny, :]
-    return sfft.irfft(ph, n=lx, axis=-1, workers=1)[..., :nx]
+        ph = np.fft.ifft(ph, axis=-2)[..., :ny, :]
+    return np.fft.irfft(ph, n=lx, axis=-1)[..., :nx]
+
+
+def _binding():
+    """scipy's pocketfft binding.  Loaded from its file, not through ``import scipy.fft``: that package imports
+    scipy.special and the array-API layer, 0.2-0.3 s of every run's start (a sweep in a shell loop pays it at
+    every point); the extension itself needs none of them.  Where the file is not where scipy keeps it, the
+    package's own module."""
+    import importlib.machinery
+    import importlib.util
+    from pathlib import Path
+    name = "scipy.fft._pocketfft.pypocketfft"
+    spec = importlib.util.find_spec("scipy")  # (finds the package without running it)
+    for base in (spec.submodule_search_locations or []) if spec is not None else []:
+        for suffix in importlib.machinery.EXTENSION_SUFFIXES:
+            path = Path(base) / "fft" / "_pocketfft" / f"pypocketfft{suffix}"
+            if path.is_file():
+                loader = importlib.machinery.ExtensionFileLoader(name, str(path))
+                module = importlib.util.module_from_spec(importlib.util.spec_from_file_location(name, path,
+                                                                                                loader=loader))
+                loader.exec_module(module)
+                return module
+    from scipy.fft._pocketfft import pypocketfft  # private: verified below before use
+    return pypocketfft
 
 
 def _direct():
-    from scipy.fft._pocketfft import pypocketfft as pp  # private: verified below before use
+    pp = _binding()
 
     def forward(p: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
         ly, lx = shape
@@ -79,7 +101,16 @@ def _direct():
             ph = pp.c2c(ph, (ph.ndim - 2,), False, 2, None, 1)[..., :ny, :]
         return pp.c2r(ph, (ph.ndim - 1,), lx, False, 2, None, 1)[..., :nx]
 
-    rng = np.random.default_rng(0)
+    def along(a: np.ndarray, n: int, axis: int, kind: str) -> np.ndarray:
+        axis = axis % a.ndim
+        if kind == "irfft":
+            return pp.c2r(np.asarray(a, dtype=complex), (axis,), n, False, 2, None, 1)
+        size = a.shape[axis]
+        buf = np.zeros(a.shape[:axis] + (n,) + a.shape[axis + 1:], dtype=float if kind == "rfft" else complex)
+        buf[(slice(None),) * axis + (slice(0, min(n, size)),)] = a[(slice(None),) * axis + (slice(0, n),)]
+        return pp.r2c(buf, (axis,), True, 0, None, 1) if kind == "rfft" else pp.c2c(buf, (axis,), True, 0, buf, 1)
+
+    rng = np.random.default_rng(0)  # against numpy's own FFT (pocketfft too) before use
     for shape, p in (((10, 16), rng.random((4, 7))), ((1, 12), rng.random((1, 5))), ((10, 16), rng.random((3, 4, 7)))):
         a, b = forward(p, shape), _public_forward(p, shape)
         if a.shape != b.shape or not np.allclose(a, b, rtol=1e-12, atol=1e-12):
@@ -87,18 +118,29 @@ def _direct():
         if not np.allclose(backward(a, shape, p.shape[-2:]), _public_backward(b, shape, p.shape[-2:]), rtol=1e-12,
                            atol=1e-12):
             raise RuntimeError("pocketfft binding disagrees")
-    return forward, backward
+    q = rng.random((3, 5))
+    for kind, ref in (("rfft", np.fft.rfft), ("fft", np.fft.fft)):
+        if not np.allclose(along(q, 8, 0, kind), ref(q, 8, axis=0), rtol=1e-12, atol=1e-12):
+            raise RuntimeError("pocketfft binding disagrees")
+    if not np.allclose(along(np.fft.rfft(q, 8, axis=1), 8, 1, "irfft"), np.fft.irfft(np.fft.rfft(q, 8, axis=1), 8,
+                                                                                       axis=1), rtol=1e-12, atol=1e-12):
+        raise RuntimeError("pocketfft binding disagrees")
+    return forward, backward, along
+
+
+def _public_along(a: np.ndarray, n: int, axis: int, kind: str) -> np.ndarray:
+    return {"rfft": np.fft.rfft, "fft": np.fft.fft, "irfft": np.fft.irfft}[kind](a, n, axis=axis)
 
 
 def _choose() -> tuple:
-    global forward, backward, DIRECT
+    global forward, backward, _along, DIRECT
     try:
-        forward, backward = _direct()
+        forward, backward, _along = _direct()
         DIRECT = True
-    except Exception:  # noqa: BLE001 - any problem with the private binding means: use the public API
-        forward, backward = _public_forward, _public_backward
+    except Exception:  # noqa: BLE001 - any problem with the private binding means: numpy's FFT (the same pocketfft)
+        forward, backward, _along = _public_forward, _public_backward, _public_along
         DIRECT = False
-    return forward, backward
+    return forward, backward, _along
 
 
 def forward(p: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
@@ -110,6 +152,25 @@ def forward(p: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
 def backward(ph: np.ndarray, shape: tuple[int, int], out_shape: tuple[int, int]) -> np.ndarray:
     """Inverse of :func:`forward`, cropped to ``out_shape``."""
     return _choose()[1](ph, shape, out_shape)
+
+
+def _along(a: np.ndarray, n: int, axis: int, kind: str) -> np.ndarray:
+    return _choose()[2](a, n, axis, kind)
+
+
+def rfft(a: np.ndarray, n: int, axis: int = -1) -> np.ndarray:
+    """numpy.fft.rfft(a, n, axis) (zero-padded or cut to n) by the same binding as :func:`forward`."""
+    return _along(a, n, axis, "rfft")
+
+
+def fft(a: np.ndarray, n: int, axis: int = -1) -> np.ndarray:
+    """numpy.fft.fft(a, n, axis)."""
+    return _along(a, n, axis, "fft")
+
+
+def irfft(a: np.ndarray, n: int, axis: int = -1) -> np.ndarray:
+    """numpy.fft.irfft(a, n, axis)."""
+    return _along(a, n, axis, "irfft")
 
 
 DIRECT: bool | None = None  # known after the first transform

@@ -77,14 +77,13 @@ class Convolution:
         return self._hat
 
     def _transform(self, kernel: np.ndarray) -> np.ndarray:
-        import scipy.fft as sfft
         ny, nx = self.grid.shape
         ly, lx = self.fft_shape
         wrapped = np.zeros(self.fft_shape)
         iy = (np.arange(2 * ny - 1) - (ny - 1)) % ly
         ix = (np.arange(2 * nx - 1) - (nx - 1)) % lx
         wrapped[np.ix_(iy, ix)] = kernel
-        hat = sfft.fft(sfft.rfft(wrapped, axis=1), axis=0) if ly > 1 else sfft.rfft(wrapped, axis=1)
+        hat = fft.fft(fft.rfft(wrapped, lx, axis=1), ly, axis=0) if ly > 1 else fft.rfft(wrapped, lx, axis=1)
         # every kernel here is even in x and y, so its symbol is real: half the work in each product
         if np.abs(hat.imag).max() <= 1e-12 * np.abs(hat.real).max():
             hat = np.ascontiguousarray(hat.real)

@@ -21,6 +21,7 @@ from functools import lru_cache
 
 import numpy as np
 
+from fretsim.compliance import fft
 from fretsim.fatigue.stresses import _normal_terms, _shear_terms
 
 DEPTHS = 28  # layers below the surface: the first a twentieth of an element (the surface), then geometric
@@ -64,7 +65,6 @@ WIDTH_STEP = 64  # the kernels are made for the window's width rounded up to thi
 @lru_cache(maxsize=512)
 def _kernel(nx: int, dx: float, z: float) -> tuple:
     """The strips' kernels' FFTs at one depth for ``nx`` centres: (length, normal (3, freq), shear (3, freq))."""
-    from scipy import fft  # (here, not at import: planning a run must not pay for scipy's FFT)
     length = fft.next_fast_len(2 * nx - 1, real=True)
     offsets = np.arange(-(nx - 1), nx) * dx  # x_i − ξ_j
     out = [length]
@@ -79,7 +79,6 @@ def _kernel(nx: int, dx: float, z: float) -> tuple:
 def stresses(pressure: np.ndarray, shear: np.ndarray, dx: float, z: np.ndarray) -> StressHistory:
     """The flat's stresses at every (state, depth, centre) under the states' strip tractions (states, nx) laid on
     its grid (:func:`on_flat`): pressure compressive, shear along +x."""
-    from scipy import fft
     states, nx = pressure.shape
     # (the tractions are zero beyond nx up to the kernels' width: the same sums, to the FFT's round-off)
     width = -(-nx // WIDTH_STEP) * WIDTH_STEP

@@ -179,14 +179,14 @@ def influence_kernels(nx: int, ny: int, dx: float, dy: float, z: float, poisson:
 
 def _wrapped_transform(kernels: np.ndarray, shape: tuple[int, int]) -> np.ndarray:
     """The kernels (..., 2ny − 1, 2nx − 1) placed on the padded grid with offset 0 at [0, 0], transformed."""
-    import scipy.fft as sfft
+    from fretsim.compliance import fft
     ly, lx = shape
     ny, nx = (kernels.shape[-2] + 1) // 2, (kernels.shape[-1] + 1) // 2
     wrapped = np.zeros(kernels.shape[:-2] + shape)
     iy = (np.arange(2 * ny - 1) - (ny - 1)) % ly
     ix = (np.arange(2 * nx - 1) - (nx - 1)) % lx
     wrapped[..., iy[:, None], ix[None, :]] = kernels
-    return sfft.rfft2(wrapped, axes=(-2, -1))
+    return fft.forward(wrapped, shape)  # (rfft along x, then fft along y: rfft2's)
 
 
 def half_space_stresses(x: np.ndarray, y: np.ndarray, dx: float, dy: float, pressure: np.ndarray,
@@ -195,7 +195,7 @@ def half_space_stresses(x: np.ndarray, y: np.ndarray, dx: float, dy: float, pres
     nx), under the elements' uniform pressure and shear tractions (MPa, arrays (ny, nx)).  ``x`` and ``y`` are
     the element centres (mm; uniform steps dx, dy); ``depths`` must be positive — for the surface itself take a
     depth small against the elements (the fields are continuous there away from the element edges)."""
-    import scipy.fft as sfft
+    from fretsim.compliance import fft
     from fretsim.compliance.fft import next_fast_len
     x, y = np.asarray(x, float), np.asarray(y, float)
     ny, nx = y.size, x.size
@@ -205,7 +205,7 @@ def half_space_stresses(x: np.ndarray, y: np.ndarray, dx: float, dy: float, pres
     loads = tuple(bool(np.any(t != 0)) for t in tractions)
     # linear (non-periodic) convolution needs at least 2n − 1 points per axis
     shape = (next_fast_len(2 * ny - 1, real=False), next_fast_len(2 * nx - 1, real=True))
-    hats = [sfft.rfft2(t, s=shape) if on else None for t, on in zip(tractions, loads)]
+    hats = [fft.forward(t, shape) if on else None for t, on in zip(tractions, loads)]
     out = np.zeros((6, depths.size, ny, nx))
     if not any(loads):
         return Stress3D(*out)
@@ -215,7 +215,7 @@ def half_space_stresses(x: np.ndarray, y: np.ndarray, dx: float, dy: float, pres
         for k in range(6):
             # the loads add in Fourier space: one inverse transform per component
             total = sum(kernel_hat[i, k] * hats[m] for i, m in enumerate(on))
-            out[k, d] = sfft.irfft2(total, s=shape)[:ny, :nx]
+            out[k, d] = fft.backward(total, shape, (ny, nx))
     return Stress3D(*out)
 
 
