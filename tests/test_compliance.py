@@ -8,6 +8,7 @@ from fretsim.compliance import HalfSpace, love_rectangle, strip_plane_strain
 from fretsim.grid import Grid
 
 ROUND_OFF = 1e-12  # FFT vs direct summation: both exact up to floating point
+CASES = Path(__file__).resolve().parent.parent / "cases"
 
 
 def test_love_centre_of_square_matches_closed_form():
@@ -115,13 +116,60 @@ def test_windows_of_one_shape_share_one_symbol_wherever_they_lie():
 
 
 def test_direct_fft_path_equals_the_public_scipy_api():
+    """The binding loaded from its file (not through scipy.fft) against scipy.fft's public functions: the padded 2D
+    transforms both ways and the axis helpers the kernels' symbols and the fatigue stresses use."""
+    import scipy.fft as sfft
+    fft_module.forward(np.zeros((1, 3)), (1, 6))
+    assert fft_module.DIRECT
     rng = np.random.default_rng(3)
     for shape, p in (((14, 40), rng.random((7, 19))), ((1, 64), rng.random((1, 30)))):
         direct = fft_module.forward(p, shape)
-        public = fft_module._public_forward(p, shape)
+        ly, lx = shape
+        public = sfft.fft(sfft.rfft(p, lx, axis=-1), ly, axis=-2) if ly > 1 else sfft.rfft(p, lx, axis=-1)
         assert np.abs(direct - public).max() <= ROUND_OFF * np.abs(public).max()
         back = fft_module.backward(direct, shape, p.shape)
-        assert np.abs(back - fft_module._public_backward(public, shape, p.shape)).max() <= ROUND_OFF
+        assert np.abs(back - p).max() <= ROUND_OFF
+    q = rng.random((5, 6, 7))
+    for axis in (0, 1, -1):
+        assert np.abs(fft_module.rfft(q, 12, axis) - sfft.rfft(q, 12, axis=axis)).max() <= ROUND_OFF * 10
+        assert np.abs(fft_module.fft(q, 9, axis) - sfft.fft(q, 9, axis=axis)).max() <= ROUND_OFF * 10
+        h = sfft.rfft(q, 12, axis=axis)
+        assert np.abs(fft_module.irfft(h, 12, axis) - sfft.irfft(h, 12, axis=axis)).max() <= ROUND_OFF
+
+
+def test_without_the_binding_numpys_fft_stands_in_with_the_same_numbers(monkeypatch):
+    """Where scipy's binding cannot be loaded (moved, another scipy), numpy's FFT (pocketfft too) is used: the same
+    convolutions to round-off, and nothing fails."""
+    rng = np.random.default_rng(8)
+    p, shape = rng.random((3, 7, 19)), (14, 40)
+    want = fft_module.backward(fft_module.forward(p, shape) * 2.0, shape, (7, 19))
+    keep = (fft_module.forward, fft_module.backward, fft_module._along, fft_module.DIRECT)
+
+    def broken():
+        raise ImportError("no binding here")
+    try:
+        monkeypatch.setattr(fft_module, "_binding", broken)
+        fft_module._choose()
+        assert fft_module.DIRECT is False
+        got = fft_module.backward(fft_module.forward(p, shape) * 2.0, shape, (7, 19))
+        assert np.abs(got - want).max() <= ROUND_OFF
+        assert np.abs(fft_module.rfft(p, 24, 1) - np.fft.rfft(p, 24, axis=1)).max() == 0.0
+    finally:
+        fft_module.forward, fft_module.backward, fft_module._along, fft_module.DIRECT = keep
+
+
+def test_a_run_imports_neither_scipys_fft_nor_ndimage_nor_interpolate(tmp_path):
+    """A 3D run of the 185 N case in a fresh process: scipy.fft (with scipy.special and the array-API layer),
+    scipy.ndimage and scipy.interpolate cost 0.2-0.3 s of every start and are not imported (the FFT binding is
+    loaded from its file; the stroke average and the monotone cubic are written here)."""
+    import subprocess
+    import sys
+    code = ("import sys; from fretsim.api import load_case, run; "
+            f"run(load_case({str(CASES / 'mccoll_185N.yaml')!r}, ['loading.cycles=100', 'grid.error_estimate=none'])); "
+            "print(sorted(m for m in ('scipy.fft', 'scipy.ndimage', 'scipy.interpolate', 'scipy.special') "
+            "if m in sys.modules))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path, check=True)
+    assert out.stdout.strip().splitlines()[-1] == "[]"
 
 
 def test_fft_sizes_are_scipys_next_fast_len_without_importing_scipy():
