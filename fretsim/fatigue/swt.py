@@ -659,10 +659,13 @@ def _may_hold_extreme(local: np.ndarray, theta: float, youngs: float, poisson: f
     slide's history (the seat on a rail: 89 entries) keeps about a quarter in the fine cone."""
     sn = local[..., 2]
     trace = local @ np.array([1.0, 1.0, 1.0, 0.0, 0.0, 0.0])
-    dev2 = (local * local) @ np.array([1.0, 1.0, 1.0, 2.0, 2.0, 2.0]) - trace * trace / 3.0  # |dev σ|²
+    # |dev σ|² from the normal stresses' differences, not Σσ² − (tr σ)²/3: that cancels where the mean stress is far
+    # larger than the deviator and could make the margin too small
+    d = local[..., [0, 1, 2]] - local[..., [1, 2, 0]]
+    dev2 = (d * d) @ np.full(3, 1.0 / 3.0) + (local[..., 3:] * local[..., 3:]) @ np.full(3, 2.0)
     # (widened by a part in 10⁹ of the stresses' scale: the bound's own round-off never drops an extreme)
     scale = max(float(trace.max(initial=0.0)), -float(trace.min(initial=0.0)), float(dev2.max(initial=0.0)) ** 0.5)
-    ms = np.sqrt(np.maximum(2.0 * dev2, 0.0))
+    ms = np.sqrt(2.0 * dev2)
     ms *= math.sin(theta) * (1 + 1e-9)
     ms += 1e-9 * scale
     k = (1.0 + poisson) / youngs
