@@ -482,6 +482,7 @@ def _body_fatigue(s: dict, body: str, f, both: bool) -> str:
     v = lambda key: s.get(keyed(key, body), float("nan"))  # noqa: E731
     n = v("cycles_to_crack_initiation")
     err = s.get("estimated_error_cycles_to_crack", float("nan")) if body == "stationary" else float("nan")
+    err_d = s.get("estimated_error_fatigue_damage", float("nan")) if body == "stationary" else float("nan")
     crit = f.critical_distance
     across = lambda key: (f", y = {v(key) * 1e3:.4g} µm" if math.isfinite(v(key)) else "")  # noqa: E731  (3D)
     where = (f"the largest point SWT {v('swt_max_MPa'):.3g} MPa at x = {v('swt_location_x_mm') * 1e3:.4g} µm"
@@ -493,7 +494,8 @@ def _body_fatigue(s: dict, body: str, f, both: bool) -> str:
         return (f"{head}: a crack starts at cycle {n:,.0f}" + (f" (± {err:.1e} relative)" if math.isfinite(err)
                                                                else "")
                 + f" at x = {v('crack_location_x_mm') * 1e3:.4g} µm{across('crack_location_y_mm')} ({where})")
-    return (f"{head}: no crack within the run (Miner's sum reached {v('fatigue_damage'):.3g} of 1; {where})")
+    return (f"{head}: no crack within the run (Miner's sum reached {v('fatigue_damage'):.3g} of 1"
+            + (f", ± {err_d:.1e} relative" if math.isfinite(err_d) else "") + f"; {where})")
 
 
 def _said(outcome) -> str:

@@ -128,14 +128,32 @@ def cycles_to_limit_estimate(fine: dict, coarse: Optional[dict], limit: Optional
     return float((fine["error_estimate_depth"] + model_part) / exponent + spread / n + abs(n - n_coarse) / n)
 
 
-FATIGUE_KEYS = ("estimated_error_cycles_to_crack", "estimated_error_swt_max")
+FATIGUE_KEYS = ("estimated_error_cycles_to_crack", "estimated_error_swt_max", "estimated_error_fatigue_damage")
+
+
+def fatigue_over(fine: dict, coarse: dict, estimates: dict, accuracy: float) -> list:
+    """A note where the crack cycle's estimated error (or, without a crack, Miner's sum's) exceeds model.accuracy,
+    with its three parts and what narrows each: [] where it does not (or is not known)."""
+    crack = math.isfinite(fine.get("cycles_to_crack_initiation", math.nan))
+    key, what, value = (("estimated_error_cycles_to_crack", "the crack cycle", "cycles_to_crack_initiation") if crack
+                        else ("estimated_error_fatigue_damage", "Miner's sum at the end", "fatigue_damage"))
+    total = estimates.get(key, math.nan)
+    if not (math.isfinite(total) and total > accuracy):
+        return []
+    states = fine.get("fatigue_states_error", math.nan)
+    grid = abs(fine[value] - coarse.get(value, math.nan)) / fine[value]
+    return [f"the estimated error of {what} {total:.1%} exceeds model.accuracy ({accuracy:.2%}): the fatigue states' "
+            f"spacing {states if math.isfinite(states) else 0.0:.1%} (the sum over every other state; more "
+            f"output.snapshots where the damage grows add states), the companion grid's {grid:.1%} (a finer "
+            f"grid.elements), the stepping's {fine['error_estimate_depth']:.1%}"]
 
 
 def fatigue_estimates(fine: dict, coarse: dict) -> dict:
     """The grid's part of the fatigue figures' relative error, read directly from the companion's (the crack cycle
     follows the SWT's peak at the contact's edge, which converges like the pressure's peak: no Richardson factor is
     claimed), plus the depths' stepping part and the fatigue states' spacing part (Miner's sum over every other
-    state) for the crack cycle.  NaN where either run has no crack."""
+    state) for the crack cycle (NaN where either run has no crack) and, the same three parts, for Miner's sum at the
+    run's end (fatigue_damage: what a run without a crack reports of its fatigue)."""
     crack, crack_c = fine.get("cycles_to_crack_initiation", math.nan), coarse.get("cycles_to_crack_initiation",
                                                                                  math.nan)
     states = fine.get("fatigue_states_error", math.nan)
@@ -144,4 +162,8 @@ def fatigue_estimates(fine: dict, coarse: dict) -> dict:
            if math.isfinite(crack) and math.isfinite(crack_c) and crack > 0 else math.nan}
     swt, swt_c = fine.get("swt_max_MPa", math.nan), coarse.get("swt_max_MPa", math.nan)
     out["estimated_error_swt_max"] = _relative(swt, swt_c) if math.isfinite(swt) and math.isfinite(swt_c) else math.nan
+    d, d_c = fine.get("fatigue_damage", math.nan), coarse.get("fatigue_damage", math.nan)
+    out["estimated_error_fatigue_damage"] = (abs(d - d_c) / d + fine["error_estimate_depth"]
+                                             + (states if math.isfinite(states) else 0.0)) if (
+        math.isfinite(d) and math.isfinite(d_c) and d > 0) else math.nan
     return out

@@ -599,6 +599,7 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
     out[grid_error.LIMIT_KEY] = grid_error.cycles_to_limit_estimate(summary, coarse, counter.last.limit, model_part)
     if setup.fatigue is not None:
         out.update(grid_error.fatigue_estimates(summary, coarse))
+        counter.notes.extend(grid_error.fatigue_over(summary, coarse, out, filled.accuracy))
     if counter.last.limit is not None and not math.isfinite(out[grid_error.LIMIT_KEY]):
         counter.notes.append("the grid's part of cycles_to_limit was not estimated: the companion run on a grid "
                              "twice as coarse reached no limit within loading.cycles")
