@@ -135,6 +135,11 @@ def fatigue_over(fine: dict, coarse: dict, estimates: dict, accuracy: float) -> 
     """A note where the crack cycle's estimated error (or, without a crack, Miner's sum's) exceeds model.accuracy,
     with its three parts and what narrows each: [] where it does not (or is not known)."""
     crack = math.isfinite(fine.get("cycles_to_crack_initiation", math.nan))
+    if crack and not math.isfinite(coarse.get("cycles_to_crack_initiation", math.nan)):
+        return [f"the crack cycle's error was not estimated: the companion run on a grid twice as coarse had no crack "
+                f"within the run (Miner's sum there {coarse.get('fatigue_damage', math.nan):.3g}, here "
+                f"{fine.get('fatigue_damage', math.nan):.3g}): whether and when a crack starts depends on the grid here "
+                f"(a finer grid.elements says which)"]
     key, what, value = (("estimated_error_cycles_to_crack", "the crack cycle", "cycles_to_crack_initiation") if crack
                         else ("estimated_error_fatigue_damage", "Miner's sum at the end", "fatigue_damage"))
     total = estimates.get(key, math.nan)
@@ -142,10 +147,11 @@ def fatigue_over(fine: dict, coarse: dict, estimates: dict, accuracy: float) -> 
         return []
     states = fine.get("fatigue_states_error", math.nan)
     grid = abs(fine[value] - coarse.get(value, math.nan)) / fine[value]
+    spacing = f"{states:.1%}" if math.isfinite(states) else "not measured (too few states)"
     return [f"the estimated error of {what} {total:.1%} exceeds model.accuracy ({accuracy:.2%}): the fatigue states' "
-            f"spacing {states if math.isfinite(states) else 0.0:.1%} (the sum over every other state; more "
-            f"output.snapshots where the damage grows add states), the companion grid's {grid:.1%} (a finer "
-            f"grid.elements), the stepping's {fine['error_estimate_depth']:.1%}"]
+            f"spacing {spacing} (the sum over every other state; more output.snapshots where the damage grows add "
+            f"states), the companion grid's {grid:.1%} (a finer grid.elements), the stepping's "
+            f"{fine['error_estimate_depth']:.1%}"]
 
 
 def fatigue_estimates(fine: dict, coarse: dict) -> dict:

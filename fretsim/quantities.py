@@ -130,7 +130,9 @@ SUMMARY: dict[str, Figure] = {
     "fatigue_states_error": Figure("1", nan=True),  # the crack cycle's (or damage's) change with half the states
     "estimated_error_cycles_to_crack": Figure("1", nan=True),  # no crack in the run or its companion, or none run
     "estimated_error_swt_max": Figure("1", nan=True),
-    "estimated_error_fatigue_damage": Figure("1", nan=True),  # Miner's sum at the end: companion, stepping, states
+    # Miner's sum at the end: the companion's difference, the depths' stepping, fatigue_states_error (which is the
+    # crack cycle's where the run cracked)
+    "estimated_error_fatigue_damage": Figure("1", nan=True),
     # the moving body's (materials.moving.fatigue; absent otherwise): the same figures on its own half-space,
     # named as the flat's with _moving before the unit; damage_mode above counts both bodies' cracks
     "max_shear_stress_moving_MPa": Figure("MPa"),

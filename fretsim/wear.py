@@ -67,6 +67,14 @@ def stroke_average(pressure: np.ndarray, dx: float, stroke: float) -> np.ndarray
             abs(w[reach - inner - 1] - full) <= 1e-12 * full:
         inner += 1
     p = np.asarray(pressure, dtype=float)
+    if not np.isfinite(p).all():  # (running sums would carry a NaN or inf along the row: term by term, where it is)
+        out = w[reach] * p
+        for k in range(1, reach + 1):
+            for weight, src, dst in ((w[reach + k], np.s_[..., :-k], np.s_[..., k:]),
+                                     (w[reach - k], np.s_[..., k:], np.s_[..., :-k])):
+                if weight:
+                    out[dst] += weight * p[src]
+        return out
     n = p.shape[-1]
     padded = np.zeros(p.shape[:-1] + (n + 2 * reach + 1,))
     padded[..., reach + 1:reach + 1 + n] = p  # padded[j + reach + 1] = p[j]; one zero more in front for the sums

@@ -525,6 +525,11 @@ def test_miners_sum_at_the_end_carries_an_estimate_and_a_note_where_it_exceeds_t
     est = fatigue_estimates(cracked, {**coarse, "cycles_to_crack_initiation": 8800.0})
     [note] = fatigue_over(cracked, {**coarse, "cycles_to_crack_initiation": 8800.0}, est, 0.01)
     assert note.startswith("the estimated error of the crack cycle")
+    # a crack on the run's grid and none on the companion's: the crack cycle's error is not known, and said
+    [note] = fatigue_over(cracked, coarse, fatigue_estimates(cracked, coarse), 0.01)
+    assert note.startswith("the crack cycle's error was not estimated") and "no crack" in note
+    assert "not measured" in fatigue_over({**fine, "fatigue_states_error": float("nan")}, coarse, {
+        "estimated_error_fatigue_damage": 0.2}, 0.01)[0]
     summary = {**fine, "estimated_error_fatigue_damage": 0.252, "swt_location_x_mm": 0.095, "swt_depth_um": 0.28}
     spec = SimpleNamespace(critical_distance=0.025)
     assert "reached 0.103 of 1, ± 2.5e-01 relative" in _body_fatigue(summary, "stationary", spec, False)

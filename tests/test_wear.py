@@ -61,6 +61,12 @@ def test_stroke_average_by_running_sums_is_the_weighted_sum_and_exactly_zero_bey
         got = stroke_average(p, dx, stroke)
         assert np.abs(got - want).max() <= 1e-13 * want.max()
         assert np.array_equal(got == 0.0, want == 0.0)
+    p = np.zeros((1, 60))
+    p[0, 10], p[0, 40] = np.nan, 1.0  # a NaN stays where its weights reach (running sums would carry it on)
+    got = stroke_average(p, dx, stroke)
+    offsets = np.arange(60) - 10
+    reached = (np.abs(offsets) <= reach) & (w[np.clip(reach + offsets, 0, 2 * reach)] != 0)
+    assert np.array_equal(np.isnan(got[0]), reached)
 
 
 def test_archard_depth_and_volume_follow_eqs_15_16():

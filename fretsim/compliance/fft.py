@@ -102,9 +102,16 @@ def _direct():
         return pp.c2r(ph, (ph.ndim - 1,), lx, False, 2, None, 1)[..., :nx]
 
     def along(a: np.ndarray, n: int, axis: int, kind: str) -> np.ndarray:
+        a = np.asarray(a)
         axis = axis % a.ndim
-        if kind == "irfft":
-            return pp.c2r(np.asarray(a, dtype=complex), (axis,), n, False, 2, None, 1)
+        if kind == "irfft":  # (the first n // 2 + 1 coefficients, zero-padded where fewer: numpy's irfft)
+            half = n // 2 + 1
+            spec = np.zeros(a.shape[:axis] + (half,) + a.shape[axis + 1:], dtype=complex)
+            keep = (slice(None),) * axis + (slice(0, min(half, a.shape[axis])),)
+            spec[keep] = a[keep]
+            return pp.c2r(spec, (axis,), n, False, 2, None, 1)
+        if kind == "rfft" and np.iscomplexobj(a):
+            raise TypeError("rfft of complex input")
         size = a.shape[axis]
         buf = np.zeros(a.shape[:axis] + (n,) + a.shape[axis + 1:], dtype=float if kind == "rfft" else complex)
         buf[(slice(None),) * axis + (slice(0, min(n, size)),)] = a[(slice(None),) * axis + (slice(0, n),)]

@@ -193,6 +193,8 @@ def pchip(xs: np.ndarray, ys: np.ndarray, x: np.ndarray) -> np.ndarray:
     [xs[0], xs[-1]].  Here rather than scipy's: scipy.interpolate costs 0.2 s to import, a fifth of planning a
     free-faces case (the run and `check` both pay it)."""
     xs, ys, x = np.asarray(xs, float), np.asarray(ys, float), np.asarray(x, float)
+    if xs.ndim != 1 or len(xs) < 2 or not (np.diff(xs) > 0).all() or len(ys) != len(xs):
+        raise ValueError("pchip needs at least two strictly increasing abscissae, one sample each")
     shape = (-1,) + (1,) * (ys.ndim - 1)
     h = np.diff(xs)
     m = np.diff(ys, axis=0) / h.reshape(shape)

@@ -631,7 +631,7 @@ def _cone(s: np.ndarray, centre: np.ndarray, youngs: float, poisson: float, half
     own, w = _plane_weights(own)
     w_e = (1.0 + poisson) / youngs * w - poisson / youngs * np.array([1.0, 1, 1, 0, 0, 0])[:, None]  # (tr σ kept)
     points, times = local.shape[:2]
-    if times < PRUNE_FROM:  # (laid time first: the extremes over it are whole-array maxima, 4x a middle axis's)
+    if times < PRUNE_FROM or not np.isfinite(local).all():  # (laid time first: the extremes over it are whole-array maxima, 4x a middle axis's)
         flat = np.ascontiguousarray(local.transpose(1, 0, 2)).reshape(-1, 6)
         sn, en = (flat @ w).reshape(times, points, -1), (flat @ w_e).reshape(times, points, -1)
         value = np.maximum(sn.max(axis=0), 0.0) * 0.5 * (en.max(axis=0) - en.min(axis=0))
