@@ -196,7 +196,6 @@ def half_space_stresses(x: np.ndarray, y: np.ndarray, dx: float, dy: float, pres
     the element centres (mm; uniform steps dx, dy); ``depths`` must be positive — for the surface itself take a
     depth small against the elements (the fields are continuous there away from the element edges)."""
     from fretsim.compliance import fft
-    from fretsim.compliance.fft import next_fast_len
     x, y = np.asarray(x, float), np.asarray(y, float)
     ny, nx = y.size, x.size
     tractions = [np.zeros((ny, nx)) if t is None else np.asarray(t, float) for t in (pressure, shear_x, shear_y)]
@@ -204,7 +203,7 @@ def half_space_stresses(x: np.ndarray, y: np.ndarray, dx: float, dy: float, pres
     depths = np.atleast_1d(np.asarray(depths, float))
     loads = tuple(bool(np.any(t != 0)) for t in tractions)
     # linear (non-periodic) convolution needs at least 2n − 1 points per axis
-    shape = (next_fast_len(2 * ny - 1, real=False), next_fast_len(2 * nx - 1, real=True))
+    shape = (fft.next_fast_len(2 * ny - 1, real=False), fft.next_fast_len(2 * nx - 1, real=True))
     hats = [fft.forward(t, shape) if on else None for t, on in zip(tractions, loads)]
     out = np.zeros((6, depths.size, ny, nx))
     if not any(loads):
@@ -247,7 +246,8 @@ def stress_history(pressure: np.ndarray, shear_x: np.ndarray, dx: float, dy: flo
     """The six stresses at every (state, depth, y, x) under each state's pressure and shear along x (arrays (state,
     ny, nx) on a uniform grid): shape (6, state, depth, ny, nx) in :data:`COMPONENTS`' order.  The cycle's states
     at once: each depth's kernels are made (or found) once for all of them — a fatigue state's dozen states would
-    otherwise pay the kernels a dozen times."""
+    otherwise pay the kernels a dozen times.  ``single``: the transforms and the result in single precision (a
+    fatigue state between recorded ones, whose search's first pass is single anyway)."""
     from fretsim.compliance import fft
     pressure, shear_x = np.asarray(pressure, float), np.asarray(shear_x, float)
     states, ny, nx = pressure.shape
