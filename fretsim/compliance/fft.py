@@ -57,24 +57,12 @@ def _public_backward(ph: np.ndarray, shape: tuple[int, int], out_shape: tuple[in
 
 
 def _binding():
-    """scipy's pocketfft binding.  Loaded from its file, not through ``import scipy.fft``: that package imports
-    scipy.special and the array-API layer, 0.2-0.3 s of every run's start (a sweep in a shell loop pays it at
-    every point); the extension itself needs none of them.  Where the file is not where scipy keeps it, the
-    package's own module."""
-    import importlib.machinery
-    import importlib.util
-    from pathlib import Path
-    name = "scipy.fft._pocketfft.pypocketfft"
-    spec = importlib.util.find_spec("scipy")  # (finds the package without running it)
-    for base in (spec.submodule_search_locations or []) if spec is not None else []:
-        for suffix in importlib.machinery.EXTENSION_SUFFIXES:
-            path = Path(base) / "fft" / "_pocketfft" / f"pypocketfft{suffix}"
-            if path.is_file():
-                loader = importlib.machinery.ExtensionFileLoader(name, str(path))
-                module = importlib.util.module_from_spec(importlib.util.spec_from_file_location(name, path,
-                                                                                                loader=loader))
-                loader.exec_module(module)
-                return module
+    """scipy's pocketfft binding (:func:`fretsim.native.load`: not through ``import scipy.fft``); where the file is
+    not where scipy keeps it, the package's own module."""
+    from fretsim.native import load
+    module = load("fft/_pocketfft/pypocketfft", "scipy.fft._pocketfft.pypocketfft")
+    if module is not None:
+        return module
     from scipy.fft._pocketfft import pypocketfft  # private: verified below before use
     return pypocketfft
 

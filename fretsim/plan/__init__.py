@@ -185,5 +185,5 @@ def _filled(case: Case, grids, operators, cycles, steps) -> Case:
     """The case with every automatic choice written out: it runs again (or resumes) exactly."""
     return case.with_choices(dimension=grids.dimension, corrections=operators.corrections or "none",
                              domain=grids.domain, elements=grids.elements, gap_model=operators.gap_model,
-                             scheme=steps.scheme, slip=cycles.slip, stroke_model=cycles.stroke_model,
+                             scheme=steps.scheme, slip=cycles.slip, stroke_model=cycles.stroke_model, increments=cycles.increments,
                              linear_jump=steps.linear_jump, max_jump=steps.max_jump, snapshots=steps.snapshots)

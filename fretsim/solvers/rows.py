@@ -339,6 +339,10 @@ def cg_coupled(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float, co
         return None
     p *= (total / p.sum(axis=A))[:, None, None]
     u, c = op(p), couple(p)
+    # the search directions' images in single precision (a 3D window's double transforms cost 4-6 times): the
+    # displacement they update drifts by about 1e-7 of itself an iteration, so it is recomputed in double every
+    # RECOMPUTE_EVERY iterations and before convergence is judged (PENETRATION is 1e-6)
+    fast = op.single() if hasattr(op, "single") else op
     t = np.zeros_like(p)
     lw = (np.ones(p.shape[0]) if layer_weights is None else np.asarray(layer_weights, float))[:, None, None]
     gz_old, delta = 1.0, 0.0
@@ -354,7 +358,7 @@ def cg_coupled(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float, co
         beta = delta * gz / gz_old if delta > 0 and gz_old != 0.0 else 0.0
         t = (z + beta * t) * w
         gz_old = gz
-        r_op, r_c = op(t), couple(t)
+        r_op, r_c = fast(t), couple(t)
         r = r_op + r_c
         denom = float((lw * r * t).sum() - (lw[:, 0, 0] * (r * w).sum(axis=A) / count * t.sum(axis=A)).sum())
         penetrating = ~mask & allowed & (g < 0.0)
@@ -393,6 +397,9 @@ def cg_coupled(op, gaps: np.ndarray, load: float, p0: np.ndarray, tol: float, co
         change = float((np.abs(p - p_old).sum(axis=A) / total).max())
         if not np.isfinite(change):
             return None
-        if change < tol and not pen.any() and _complementary_rows(u + c, h, p, allowed).all():  # (as solve_cg)
-            return p, it, change
+        if change < tol and not pen.any():
+            if fast is not op:  # (judged on the displacement in double)
+                u, c = op(p), couple(p)
+            if _complementary_rows(u + c, h, p, allowed).all():  # (as solve_cg)
+                return p, it, change
     return None

@@ -1,0 +1,104 @@
+"""scipy's compiled kernels, called without importing their packages.
+
+The solver's inner loops use two of scipy's extension modules: pocketfft (the transforms,
+:mod:`fretsim.compliance.fft`) and sparsetools (the resolved stroke's sparse read and deposit,
+:func:`row_matrix`).  Their packages cost far more to import than the kernels do to load: ``import scipy.fft``
+0.2-0.3 s (scipy.special, the array-API layer), ``import scipy.sparse`` 0.13-0.2 s (the array-API layer and
+numpy.f2py) — a fifth of a 2D resolved run, paid again by every process of a sweep.  The extension modules load
+in under a millisecond and need neither.  Each is loaded from its file where scipy keeps it and checked against
+numpy before use; numpy's own functions stand in where it is missing or disagrees (the same numbers).
+"""
+from __future__ import annotations
+
+from typing import Optional
+
+import numpy as np
+
+
+def load(relative: str, name: str):
+    """scipy's extension module ``name`` (e.g. ``scipy.sparse._sparsetools``) from its file ``relative`` to the
+    scipy package (``sparse/_sparsetools``), without running any package's ``__init__``; None where not found."""
+    import importlib.machinery
+    import importlib.util
+    from pathlib import Path
+    spec = importlib.util.find_spec("scipy")  # (finds the package without running it)
+    for base in (spec.submodule_search_locations or []) if spec is not None else []:
+        for suffix in importlib.machinery.EXTENSION_SUFFIXES:
+            path = Path(base) / f"{relative}{suffix}"
+            if path.is_file():
+                loader = importlib.machinery.ExtensionFileLoader(name, str(path))
+                module = importlib.util.module_from_spec(importlib.util.spec_from_file_location(name, path,
+                                                                                                loader=loader))
+                loader.exec_module(module)
+                return module
+    return None
+
+
+class RowMatrix:
+    """A sparse matrix stored by rows (CSR) from its entries (``rows`` ascending, ``cols``), whose values are given
+    with each product: one structure serves several matrices with the same entries (the resolved stroke's read,
+    and its deposit, which is the read's transpose with other weights).  Duplicate entries add."""
+
+    def __init__(self, rows: np.ndarray, cols: np.ndarray, shape: tuple[int, int]):
+        if rows.size and (np.diff(rows) < 0).any():
+            raise ValueError("a RowMatrix's rows must be ascending")
+        if max(shape) >= 2 ** 31 or rows.size >= 2 ** 31:
+            raise ValueError("a RowMatrix this large needs 64-bit indices")
+        self.shape = shape
+        self.rows, self.indices = rows.astype(np.int32), cols.astype(np.int32)
+        self.indptr = np.zeros(shape[0] + 1, np.int32)
+        np.cumsum(np.bincount(rows, minlength=shape[0]), out=self.indptr[1:])
+
+    def dot(self, values: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """A·x, A the matrix with these entries' ``values``."""
+        return _kernels()[0](self, np.ascontiguousarray(values, float), np.ascontiguousarray(x, float))
+
+    def dot_transposed(self, values: np.ndarray, x: np.ndarray) -> np.ndarray:
+        """Aᵀ·x."""
+        return _kernels()[1](self, np.ascontiguousarray(values, float), np.ascontiguousarray(x, float))
+
+
+def _numpy_dot(a: RowMatrix, values, x):
+    return np.bincount(a.rows, weights=values * x[a.indices], minlength=a.shape[0])
+
+
+def _numpy_dot_transposed(a: RowMatrix, values, x):
+    return np.bincount(a.indices, weights=values * x[a.rows], minlength=a.shape[1])
+
+
+_KERNELS: Optional[tuple] = None
+
+
+def _kernels() -> tuple:
+    """sparsetools' products (its CSR and, read as the transpose's CSC, the same arrays), checked against numpy's
+    on a small random matrix; numpy's where they are missing or disagree."""
+    global _KERNELS
+    if _KERNELS is None:
+        _KERNELS = (_numpy_dot, _numpy_dot_transposed)
+        try:
+            tools = load("sparse/_sparsetools", "scipy.sparse._sparsetools")
+            if tools is not None:
+                def dot(a, values, x):
+                    y = np.zeros(a.shape[0])
+                    tools.csr_matvec(a.shape[0], a.shape[1], a.indptr, a.indices, values, x, y)
+                    return y
+
+                def dot_transposed(a, values, x):
+                    y = np.zeros(a.shape[1])
+                    tools.csc_matvec(a.shape[1], a.shape[0], a.indptr, a.indices, values, x, y)
+                    return y
+                if _agrees(dot, dot_transposed):
+                    _KERNELS = (dot, dot_transposed)
+        except Exception:  # noqa: BLE001 - any problem with the private module means: numpy's products
+            pass
+    return _KERNELS
+
+
+def _agrees(dot, dot_transposed) -> bool:
+    rng = np.random.default_rng(0)
+    rows = np.sort(rng.integers(0, 7, 40))
+    a = RowMatrix(rows, rng.integers(0, 11, 40), (9, 11))  # (rows 7, 8 empty; duplicates)
+    values, x, z = rng.random(40), rng.random(11), rng.random(9)
+    return bool(np.allclose(dot(a, values, x), _numpy_dot(a, values, x), rtol=1e-13, atol=1e-14) and
+                np.allclose(dot_transposed(a, values, z), _numpy_dot_transposed(a, values, z), rtol=1e-13,
+                            atol=1e-14))

@@ -1,0 +1,69 @@
+"""scipy's kernels loaded from their files (fretsim.native): the same products as numpy's, a stand-in where they
+are missing, and a resolved run that imports none of their packages."""
+from __future__ import annotations
+
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from fretsim import native
+
+CASES = Path(__file__).resolve().parent.parent / "cases"
+
+
+def _random_matrix(rng, n_rows=30, n_cols=45, entries=400):
+    rows = np.sort(rng.integers(0, n_rows - 3, entries))  # (the last rows empty; duplicate entries)
+    cols = rng.integers(0, n_cols, entries)
+    values = rng.normal(size=entries)
+    dense = np.zeros((n_rows, n_cols))
+    np.add.at(dense, (rows, cols), values)
+    return native.RowMatrix(rows, cols, (n_rows, n_cols)), values, dense
+
+
+def test_a_row_matrix_and_its_transpose_multiply_as_the_dense_matrix_does():
+    rng = np.random.default_rng(3)
+    a, values, dense = _random_matrix(rng)
+    x, z = rng.normal(size=45), rng.normal(size=30)
+    # (sums of at most a few dozen products of order 1: round-off a few 1e-15)
+    assert np.abs(a.dot(values, x) - dense @ x).max() < 1e-13
+    assert np.abs(a.dot_transposed(values, z) - dense.T @ z).max() < 1e-13
+    other = rng.normal(size=values.size)  # another matrix on the same entries
+    dense2 = np.zeros(dense.shape)
+    np.add.at(dense2, (a.rows, a.indices), other)
+    assert np.abs(a.dot(other, x) - dense2 @ x).max() < 1e-13
+
+
+def test_without_scipys_kernels_numpys_products_stand_in_with_the_same_numbers(monkeypatch):
+    rng = np.random.default_rng(5)
+    a, values, dense = _random_matrix(rng)
+    x, z = rng.normal(size=45), rng.normal(size=30)
+    want = a.dot(values, x), a.dot_transposed(values, z)
+    monkeypatch.setattr(native, "_KERNELS", None)
+    monkeypatch.setattr(native, "load", lambda *args: None)
+    got = a.dot(values, x), a.dot_transposed(values, z)
+    assert native._KERNELS[0] is native._numpy_dot
+    assert np.abs(got[0] - want[0]).max() < 1e-13 and np.abs(got[1] - want[1]).max() < 1e-13
+
+
+def test_a_row_matrix_refuses_rows_out_of_order():
+    with pytest.raises(ValueError, match="ascending"):
+        native.RowMatrix(np.array([0, 2, 1]), np.array([0, 0, 0]), (3, 1))
+
+
+def test_a_resolved_run_imports_no_scipy_package():
+    """McColl 185 N 2D with the stroke resolved in a fresh process: its coupled steps' sparse products load
+    sparsetools from its file; ``import scipy.sparse`` (0.13-0.2 s: the array-API layer, numpy.f2py) was a fifth of
+    the run."""
+    code = ("import sys; from fretsim.api import load_case, run; "
+            f"o = run(load_case({str(CASES / 'mccoll_185N.yaml')!r}, ['model.dimension=2d', 'loading.cycles=2000', "
+            "'loading.friction_coefficient=0.9', 'model.slip=coulomb', 'model.stroke=resolved', "
+            "'grid.error_estimate=none'])); "
+            "print(o.status, 'scipy.sparse._sparsetools' in sys.modules, "
+            "sorted(m for m in sys.modules if m.startswith('scipy') and not m.endswith(('_sparsetools', 'pypocketfft'))))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=CASES)
+    status, coupled, modules = out.stdout.strip().splitlines()[-1].split(" ", 2)
+    assert status == "complete" and coupled == "True"  # (the coupled steps' products ran)
+    assert modules == "[]", modules
