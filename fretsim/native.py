@@ -58,6 +58,17 @@ class RowMatrix:
         return _kernels()[1](self, np.ascontiguousarray(values, float), np.ascontiguousarray(x, float))
 
 
+def scatter_add(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, x: np.ndarray, size: int) -> np.ndarray:
+    """y (``size``) with y[rows[k]] += values[k]·x[cols[k]] over the entries in order: a sparse matrix's product
+    from its entries, unsorted (numpy's bincount of the products: the same sums in the same order, where
+    sparsetools' coo_matvec saves the products' array and is 1.7x faster)."""
+    return _kernels()[2](rows, cols, np.ascontiguousarray(values, float), np.ascontiguousarray(x, float), size)
+
+
+def _numpy_scatter_add(rows, cols, values, x, size):
+    return np.bincount(rows, weights=x[cols] * values, minlength=size)
+
+
 def _numpy_dot(a: RowMatrix, values, x):
     return np.bincount(a.rows, weights=values * x[a.indices], minlength=a.shape[0])
 
@@ -74,7 +85,7 @@ def _kernels() -> tuple:
     on a small random matrix; numpy's where they are missing or disagree."""
     global _KERNELS
     if _KERNELS is None:
-        _KERNELS = (_numpy_dot, _numpy_dot_transposed)
+        _KERNELS = (_numpy_dot, _numpy_dot_transposed, _numpy_scatter_add)
         try:
             tools = load("sparse/_sparsetools", "scipy.sparse._sparsetools")
             if tools is not None:
@@ -87,18 +98,27 @@ def _kernels() -> tuple:
                     y = np.zeros(a.shape[1])
                     tools.csc_matvec(a.shape[1], a.shape[0], a.indptr, a.indices, values, x, y)
                     return y
-                if _agrees(dot, dot_transposed):
-                    _KERNELS = (dot, dot_transposed)
+                def scatter(rows, cols, values, x, size):
+                    y = np.zeros(size)
+                    if cols.dtype != rows.dtype:
+                        cols = cols.astype(rows.dtype)
+                    tools.coo_matvec(rows.size, rows, cols, values, x, y)
+                    return y
+                if _agrees(dot, dot_transposed, scatter):
+                    _KERNELS = (dot, dot_transposed, scatter)
         except Exception:  # noqa: BLE001 - any problem with the private module means: numpy's products
             pass
     return _KERNELS
 
 
-def _agrees(dot, dot_transposed) -> bool:
+def _agrees(dot, dot_transposed, scatter) -> bool:
     rng = np.random.default_rng(0)
     rows = np.sort(rng.integers(0, 7, 40))
     a = RowMatrix(rows, rng.integers(0, 11, 40), (9, 11))  # (rows 7, 8 empty; duplicates)
     values, x, z = rng.random(40), rng.random(11), rng.random(9)
+    shuffled = rng.permutation(40)
     return bool(np.allclose(dot(a, values, x), _numpy_dot(a, values, x), rtol=1e-13, atol=1e-14) and
                 np.allclose(dot_transposed(a, values, z), _numpy_dot_transposed(a, values, z), rtol=1e-13,
-                            atol=1e-14))
+                            atol=1e-14) and
+                np.array_equal(scatter(rows[shuffled], a.indices[shuffled].astype(np.int64), values[shuffled], x, 9),
+                               _numpy_scatter_add(rows[shuffled], a.indices[shuffled], values[shuffled], x, 9)))

@@ -31,6 +31,7 @@ import numpy as np
 
 from fretsim.compliance import Convolution
 from fretsim.grid import Grid
+from fretsim.native import scatter_add
 
 GAP_MODELS = ("mid_stroke", "stroke_average", "resolved")
 
@@ -253,14 +254,12 @@ class Sweep:
     def deposit(self, amount: np.ndarray) -> np.ndarray:
         if self.sums:
             return self._hat.deposit(np.where(self._travels, amount.reshape(self.shape), 0.0))
-        out = np.bincount(self._flat, weights=amount.ravel()[self._from] * self._share, minlength=amount.size)
-        return out.reshape(self.shape)
+        return scatter_add(self._flat, self._from, self._share, amount.ravel(), amount.size).reshape(self.shape)
 
     def read(self, field: np.ndarray) -> np.ndarray:
         if self.sums:
             return np.where(self._travels, self._hat.read(field.reshape(self.shape)), 0.0)
-        out = np.bincount(self._from, weights=field.ravel()[self._flat] * self._share, minlength=field.size)
-        return out.reshape(self.shape)
+        return scatter_add(self._from, self._flat, self._share, field.ravel(), field.size).reshape(self.shape)
 
 
 def sweep_deposit(amount: np.ndarray, start: np.ndarray, end: np.ndarray, dx: float, kernel: str = "box") -> np.ndarray:

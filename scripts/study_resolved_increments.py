@@ -17,6 +17,12 @@ increments 1, 3, 5, 9 against 27 on McColl's four Table 4 cases (2D, μ 0.9, the
 run), and McColl 185 N in 3D (3, 5, 9 against 27; about 5 minutes): the flat's centre-line and deepest depth, its
 scar width, the moving body's centre-line depth, and the loop's time.  Writes scripts/out/
 resolved_increments_auto.{txt,csv}.
+
+``--estimate``: does a default resolved run's reported error cover what its 5 increments and its grid leave?  The
+four cases (2D) run as shipped with μ 0.9 and the stroke resolved (estimates on), against each on a grid four times
+finer along x with 27 increments: |run − reference| / reference beside the run's ``estimated_error_depth`` and
+``estimated_error_width``.  ``--3d`` adds McColl 185 N in 3D against a grid twice as fine along x with 15
+increments (four times and 27 would take an hour).  Writes scripts/out/resolved_increments_estimate.txt.
 """
 from __future__ import annotations
 
@@ -109,5 +115,36 @@ def counts() -> None:
     write_csv(rows, OUT / "resolved_increments_auto.csv")
 
 
+ESTIMATED = (("centre_wear_depth_stationary_um", "estimated_error_depth"),
+             ("centre_wear_depth_moving_um", "estimated_error_depth"),
+             ("scar_width_stationary_mm", "estimated_error_width"), ("scar_width_moving_mm", "estimated_error_width"))
+
+
+def estimate(three_d: bool = False) -> None:
+    """The default resolved run's error estimates against a reference finer in the grid and the increments."""
+    OUT.mkdir(exist_ok=True)
+    say = Report()
+    plan = [(c, "2d", 4, 27) for c in ("mccoll_185N", "mccoll_500N", "mccoll_1670N", "mccoll_500N_10um")]
+    say("The resolved stroke as shipped (auto: 5 increments, accuracy grid, estimates on) against the same case on "
+        "a finer grid along x with more increments (μ 0.9): 2D 4x and 27" + (", 3D 2x and 15" if three_d else ""))
+    say(f"{'case':<18}{'dim':<4}{'quantity':<34}{'run':>10}{'reference':>11}{'error':>9}{'estimate':>10}  covered")
+    for case, dim, finer, increments in plan + ([("mccoll_185N", "3d", 2, 15)] if three_d else []):
+        sets = ["loading.friction_coefficient=0.9", "model.slip=coulomb", "model.stroke=resolved",
+                f"model.dimension={dim}"]
+        s = run(load_case(ROOT / "cases" / f"{case}.yaml", sets)).summary
+        n = finer * s["elements_x"] + (finer * s["elements_x"] + 1) % 2  # (odd: a centred element)
+        domain = f"{s['elements_x'] * s['element_size_x_um'] * 1e-3!r} mm"
+        if dim == "3d":  # (the rows as the run's)
+            n, domain = f"{n}, {s['elements_y']}", f"{domain}, {s['elements_y'] * s['element_size_y_um'] * 1e-3!r} mm"
+        r = run(load_case(ROOT / "cases" / f"{case}.yaml", [*sets, "grid.error_estimate=none", f"grid.elements=[{n}]",
+                                                            f"grid.domain=[{domain}]",
+                                                            f"model.increments={increments}"])).summary
+        for key, est in ESTIMATED:
+            err = abs(s[key] / r[key] - 1.0)
+            say(f"{case:<18}{dim:<4}{key:<34}{s[key]:>10.5f}{r[key]:>11.5f}{err:>9.3%}{s[est]:>10.3%}  "
+                f"{'yes' if err <= s[est] else 'NO'}")
+    say.write(OUT / "resolved_increments_estimate.txt")
+
+
 if __name__ == "__main__":
-    counts() if "--counts" in sys.argv else main()
+    counts() if "--counts" in sys.argv else estimate("--3d" in sys.argv) if "--estimate" in sys.argv else main()

@@ -36,16 +36,28 @@ def test_a_row_matrix_and_its_transpose_multiply_as_the_dense_matrix_does():
     assert np.abs(a.dot(other, x) - dense2 @ x).max() < 1e-13
 
 
+def test_scatter_add_is_numpys_bincount_of_the_products_bit_for_bit():
+    """The sweep's deposit and read (fretsim.wear.Sweep) add each entry's product in the entries' order, as
+    bincount did: the same sums, not only to round-off."""
+    rng = np.random.default_rng(11)
+    rows, cols = rng.integers(0, 50, 3000), rng.integers(0, 80, 3000)
+    values, x = rng.normal(size=3000), rng.normal(size=80)
+    assert np.array_equal(native.scatter_add(rows, cols, values, x, 60),
+                          np.bincount(rows, weights=x[cols] * values, minlength=60))
+
+
 def test_without_scipys_kernels_numpys_products_stand_in_with_the_same_numbers(monkeypatch):
     rng = np.random.default_rng(5)
     a, values, dense = _random_matrix(rng)
     x, z = rng.normal(size=45), rng.normal(size=30)
     want = a.dot(values, x), a.dot_transposed(values, z)
+    want_scatter = native.scatter_add(a.rows, a.indices, values, x, 30)
     monkeypatch.setattr(native, "_KERNELS", None)
     monkeypatch.setattr(native, "load", lambda *args: None)
     got = a.dot(values, x), a.dot_transposed(values, z)
     assert native._KERNELS[0] is native._numpy_dot
     assert np.abs(got[0] - want[0]).max() < 1e-13 and np.abs(got[1] - want[1]).max() < 1e-13
+    assert np.array_equal(native.scatter_add(a.rows, a.indices, values, x, 30), want_scatter)
 
 
 def test_a_row_matrix_refuses_rows_out_of_order():

@@ -200,3 +200,23 @@ def test_proxies_are_kept_by_whoever_passes_the_side_runs_and_by_nobody_else():
     again: list = []
     prepare(case, runs=SideRuns(announce=again.append))
     assert len(again) == first  # a new keeping runs them again: nothing was left behind at module level
+
+
+def test_increments_auto_takes_five_for_a_resolved_gross_slip_stroke_and_nine_elsewhere():
+    """model.increments auto: 5 where the stroke is resolved and every elastic side fits in one of them (McColl
+    185 N: δ 25 µm, 37 δ_t; the measured table in scripts/results/resolved_increments_auto.txt); 9 for a resolved
+    stroke near or in partial slip (δ 1 µm on the same contact), 9 at mid-stroke, a given number as given; the
+    filled case carries the choice, so that the run resumes with it."""
+    mu = ["loading.friction_coefficient=0.9", "model.slip=coulomb", "model.dimension=2d"]
+
+    def chosen(*sets):
+        _, filled, plan = prepare(_case(*mu, *sets))
+        choice = next(c for c in plan.choices if c.key == "model.increments")
+        assert filled.increments == choice.value
+        return choice.value
+
+    assert chosen("model.stroke=resolved") == 5
+    assert chosen("model.stroke=resolved", "loading.stroke=3 um") == 9  # (δ_t 0.67 µm: 4.5 δ_t)
+    assert chosen("model.stroke=resolved", "loading.stroke=3.5 um") == 5  # (5.2 δ_t)
+    assert chosen("model.stroke=mid_stroke") == 9
+    assert chosen("model.stroke=resolved", "model.increments=7") == 7

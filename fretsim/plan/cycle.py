@@ -213,7 +213,7 @@ def build(case: Case, plan: Plan, grids, model, regime_: Regime, proxy_case: Cas
     """The member and the stroke model recorded, then a member for each block of the loading."""
     slip = plan.add(regime_.slip)
     stroke_model = plan.add(choose_stroke(proxy_case, slip, regime_, runs, plan_case))
-    increments = plan.add(choose_increments(case, stroke_model))
+    increments = plan.add(choose_increments(case, stroke_model, regime_))
     grid = grids.grid
     built: dict = {}  # a repeated block shares its member (and its cached operators)
 
@@ -264,23 +264,32 @@ def _check_incremental(case: Case, grids, model, plan: Plan, transition: Optiona
                              + (" (or the bodies' shapes, where given)" if case.geometry.shape_sizes() else ""))
 
 
-RESOLVED_INCREMENTS = 5  # auto, the stroke resolved: scripts/results/resolved_increments_auto.txt
-HELD_INCREMENTS = 9  # auto, the contact at mid-stroke: they draw the loop and sample a fatigue state's cycle
+RESOLVED_INCREMENTS = 5  # auto, the stroke resolved in gross slip: scripts/results/resolved_increments_auto.txt
+HELD_INCREMENTS = 9  # auto otherwise: they draw the loop and sample a fatigue state's cycle (and partial slip's)
 
 
-def choose_increments(case: Case, stroke_model: str) -> Choice:
+def choose_increments(case: Case, stroke_model: str, regime_: Regime) -> Choice:
     """The increments per half-stroke.  With the stroke resolved they are the quadrature of each point's travel
-    over the worn flat, and each costs a normal solve of the stack: 5, where McColl's four Table 4 cases (2D) and
-    185 N (3D) come within 0.1 % in depth and two elements in width of 27 increments, at two thirds of 9's
-    cost in 3D.  With the contact held at mid-stroke a half-stroke is one monotone increment for the wear,
-    whatever their number: they draw the recorded loop and sample a fatigue state's cycle, 9 as before."""
+    over the worn flat, and each costs a normal solve of the stack: 5 where every block's elastic side (2δ_t after
+    a reversal, Masing) fits in one of them (δ ≥ 5δ_t), so that after it the contact slides whole — McColl's four
+    Table 4 cases (2D) and 185 N (3D) come within 0.1 % in depth and two elements in width of 27 increments, at
+    two thirds of 9's cost in 3D, and the runs' estimates cover it; 9 otherwise (a resolved stroke in partial slip,
+    the Ti-6Al-4V fretting-fatigue case: 5 moved its depth by 0.5 % and its damage by 2 %).  With the contact held
+    at mid-stroke a half-stroke is one monotone increment for the wear, whatever their number: 9, which draw the
+    recorded loop and sample a fatigue state's cycle, as before."""
     if case.increments is not None:
         return Choice("model.increments", case.increments, "given in the case", True)
     if STROKES[stroke_model]:
-        return Choice("model.increments", RESOLVED_INCREMENTS,
-                      f"{RESOLVED_INCREMENTS} positions a half-stroke with the stroke resolved: McColl's cases come "
-                      f"within 0.1 % in depth and two elements in width of 27 (2D and 3D; "
-                      f"scripts/results/resolved_increments_auto.txt)")
+        # (the block nearest partial slip is the one whose elastic side takes the largest share of its stroke)
+        if regime_.transition is not None and regime_.block.stroke >= RESOLVED_INCREMENTS * regime_.transition:
+            return Choice("model.increments", RESOLVED_INCREMENTS,
+                          f"{RESOLVED_INCREMENTS} positions a half-stroke with the stroke resolved in gross slip (δ ≥ "
+                          f"{RESOLVED_INCREMENTS}δ_t: the elastic side fits in one): McColl's cases come within 0.1 % "
+                          f"in depth and two elements in width of 27 (2D and 3D; "
+                          f"scripts/results/resolved_increments_auto.txt)")
+        return Choice("model.increments", HELD_INCREMENTS,
+                      f"{HELD_INCREMENTS} positions a half-stroke with the stroke resolved: a stroke below "
+                      f"{RESOLVED_INCREMENTS}δ_t spends more than one of 5 increments on its elastic side")
     return Choice("model.increments", HELD_INCREMENTS,
                   f"{HELD_INCREMENTS}: the contact held at mid-stroke, they draw the recorded loop and sample a "
                   f"fatigue state's cycle (the wear does not depend on them)")

@@ -143,10 +143,18 @@ def mirror_result(res):
                          res.message + "; the mirror image of its pair's", res.residual)
 
 
-def _span(mask: np.ndarray, n: int) -> slice:
-    """The warm starts' extent along one axis and the single solve's margin round it (solvers.WINDOW_MARGIN)."""
+# the coupled solve's margin round its warm starts (elements, share of their extent): they are the last step's
+# positions grown by a few elements (fretsim.cycle.resolved.grown_start), the contact widening 1-7 elements a step;
+# a quarter (the single solve's, whose warm start may be a prediction far off) made McColl 185 N 3D's window half
+# as wide again as its contact and its coupled solves 1.25x as long.  A contact that outgrows it is solved again
+# over the whole grid (solve_coupled), so the margin buys time, not answers.
+COUPLED_MARGIN = (6, 0.1)
+
+
+def _span(mask: np.ndarray, n: int, margins: tuple = WINDOW_MARGIN) -> slice:
+    """The warm starts' extent along one axis and a margin round it (the single solve's, solvers.WINDOW_MARGIN)."""
     idx = np.flatnonzero(mask)
-    margin = max(WINDOW_MARGIN[0], int(WINDOW_MARGIN[1] * (idx[-1] - idx[0] + 1)))
+    margin = max(margins[0], int(margins[1] * (idx[-1] - idx[0] + 1)))
     return slice(max(0, idx[0] - margin), min(n, idx[-1] + margin + 1))
 
 
@@ -283,7 +291,7 @@ def _coupled_window(op, gaps, load, p0, tol, couple, on) -> tuple:
     """solve_coupled on the window of ``on`` (and its margin): (a ContactResult per layer or None, whether the
     contact outgrew a window smaller than the grid)."""
     m, ny, nx = gaps.shape
-    rows, cols = _span(on.any(axis=(0, 2)), ny), _span(on.any(axis=(0, 1)), nx)
+    rows, cols = _span(on.any(axis=(0, 2)), ny, COUPLED_MARGIN), _span(on.any(axis=(0, 1)), nx, COUPLED_MARGIN)
     whole = rows.stop - rows.start == ny and cols.stop - cols.start == nx
     win = op if whole else op.window(rows, cols)
 

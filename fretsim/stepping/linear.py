@@ -45,6 +45,7 @@ def explicit_growth_cause(setup, what: str) -> str:
 
 
 def relative_change(v: np.ndarray, ref: np.ndarray) -> float:
-    """‖v‖/‖ref‖ (0 for a zero reference)."""
-    n = float(np.linalg.norm(ref))
-    return float(np.linalg.norm(v)) / n if n > 0 else 0.0
+    """‖v‖/‖ref‖ (0 for a zero reference).  (Not np.linalg.norm: its BLAS dot woke a multithreaded BLAS's sleeping
+    threads once a step, 4 ms a call on two cores, 0.4 s of a 3D resolved run's 9 s.)"""
+    n = float(np.sqrt(np.square(ref).sum()))
+    return float(np.sqrt(np.square(v).sum())) / n if n > 0 else 0.0
