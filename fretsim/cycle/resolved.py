@@ -115,15 +115,18 @@ def travels(member, pressures: np.ndarray, du: np.ndarray, budget: Optional[int]
     if member.rigid:
         return cand, np.broadcast_to(du[:, None, None], pressures.shape).copy(), stuck, 0
     k = member.tangential
-    kq = k(cand)
+    # (a symmetric cycle's down-stroke is its up-stroke mirrored, set below: its layers' K·q are not needed)
+    solved = mirror[-1][0] + 1 if mirror else pressures.shape[0]
+    kq = np.zeros(pressures.shape)
+    kq[:solved] = k(cand[:solved])
     kq_before = np.concatenate([np.zeros((1,) + kq.shape[1:]), kq[:-1]])
     ds = du[:, None, None] - (kq - kq_before)
     slides = ((sign * ds >= 0.0) | (pressures <= 0.0)).all(axis=(1, 2))  # no point would slip against its traction
     if budget is not None and not slides[0]:  # the first, from rest over the half stroke, sticks: partial slip
         return None
-    q, iterations, solved = cand, 0, 0
+    q, iterations, count = cand, 0, 0
     exact = True  # the traction before this increment is its candidate (or rest, before the first)
-    for i in range(mirror[-1][0] + 1 if mirror else pressures.shape[0]):
+    for i in range(solved):
         if exact and slides[i]:
             continue
         if not exact:  # the traction before is the solver's: this increment's sliding candidate from it
@@ -131,8 +134,8 @@ def travels(member, pressures: np.ndarray, du: np.ndarray, budget: Optional[int]
             if ((sign[i] * ds[i] >= 0.0) | (pressures[i] <= 0.0)).all():
                 exact = True
                 continue
-        solved += 1
-        if budget is not None and solved > budget:
+        count += 1
+        if budget is not None and count > budget:
             return None
         if q is cand:
             q = cand.copy()
