@@ -16,7 +16,7 @@
 
 4. ``--ratio [--3d]``: issue 30's target, the resolved stroke against the mid-stroke Coulomb run on the same grid,
    side by side in this tree (McColl 185 N 2D, μ 0.9, grid.error_estimate none; 5 pairs, fresh processes, run in
-   turn; ``--3d`` adds one 3D pair, about two minutes): the ratio of the loop times, pair by pair.
+   turn; ``--3d`` adds three 3D pairs, about two minutes): the ratio of the loop times, pair by pair.
 
 Prints tables; writes scripts/out/bench_friction.{txt,csv,png}.
 """
@@ -81,7 +81,7 @@ def ratio(dims: tuple, say: Report, rows: list) -> None:
     say("the resolved stroke against mid-stroke, McColl 185 N, μ 0.9, 18 000 cycles (fresh processes, in turn)")
     say(f"{'dim':<5}{'pairs':>6}{'resolved s':>12}{'mid s':>9}{'ratio':>8}{'min':>7}{'max':>7}")
     for dim in dims:
-        pairs = 5 if dim == "2d" else 1
+        pairs = 5 if dim == "2d" else 3
         base = [MU, "model.slip=coulomb", f"model.dimension={dim}", "grid.error_estimate=none"]
         res, mid = [], []
         for _ in range(pairs):

@@ -463,18 +463,18 @@ def test_the_mirrored_preconditioner_is_the_whole_cycles_in_3d_where_the_images_
 def test_the_preconditioner_in_single_precision_is_the_double_ones_to_its_round_off(monkeypatch):
     """The coupled solve applies its preconditioner (an approximate inverse: CG needs it fixed and near
     symmetric, not exact) in single precision, half the transforms' work: on the 3D window above, mirrored and
-    whole, it equals the double-precision one to 2e-4 of the largest value, and returns double.  Measured 5e-5:
-    float32's 6e-8 of the transform's largest mode (the mean of this positive white-noise stack, ~50× the others)
-    lands on every mode, and 1/C lifts the high ones.  The iteration's own tests use the double operator, so this
-    moves no converged pressure beyond the solver's tolerance; McColl 185 N 3D took 1 710 iterations against
-    1 721 in double."""
+    whole, it equals the double-precision one to 2e-4 of the largest value, and returns single (the iteration's
+    product with its float64 mask promotes it exactly).  Measured 5e-5: float32's 6e-8 of the transform's largest
+    mode (the mean of this positive white-noise stack, ~50× the others) lands on every mode, and 1/C lifts the high
+    ones.  The iteration judges convergence on its displacement recomputed in double, so this moves no converged
+    pressure beyond the solver's tolerance; McColl 185 N 3D took 1 710 iterations against 1 721 in double."""
     half, whole, win, v, m = _preconditioners_3d()
     for k, x in ((half, v), (whole, np.concatenate([v, v[..., ::-1]]))):
         monkeypatch.setattr(resolved, "SINGLE", False)
         double = k.preconditioner(win, slice(None), slice(None))(x)
         monkeypatch.setattr(resolved, "SINGLE", True)
         single = k.preconditioner(win, slice(None), slice(None))(x)
-        assert single.dtype == np.float64
+        assert single.dtype == np.float32 and double.dtype == np.float64
         err = np.abs(single - double).max() / np.abs(double).max()
         assert 0.0 < err <= 2e-4, err
 

@@ -258,7 +258,7 @@ class CoulombCycle:
                                                       (q_high, p_high), tally.area,
                                                       mirror_images(self, (q_low, p_low), (q_high, p_high)))
         defect, mismatch = _step_defect(self, wear_moving, wear_stationary, step, w_lin, tally, stacks, p_mid,
-                                        travel_mid, correction, mid, corrected, visits) if step else (0.0, None)
+                                        travel_mid, correction, mid, corrected, visits, couple) if step else (0.0, None)
         cyc = tally.cycle(self, p_mid, res_mid, stick_end, defect, mismatch)
         if states:
             cyc.tractions = tuple(np.array(a) for a in zip(*states))
@@ -474,9 +474,14 @@ def masing(member: CoulombCycle, p: np.ndarray, path: list) -> list:
 
 
 def _step_defect(member: CoulombCycle, wear_moving, wear_stationary, step: float, w_lin, tally: "_Tally", stacks,
-                 p_mid, travel_mid, correction, mid: int, corrected: bool, visits: list) -> tuple:
+                 p_mid, travel_mid, correction, mid: int, corrected: bool, visits: list, coupled: bool = False) -> tuple:
     """An implicit pass's (defect, mismatch): the mismatch at mid-stroke, or for a resolved pass that a correction
-    follows (``corrected``) each increment's own."""
+    follows (``corrected``) each increment's own.  A ``coupled`` pass (resolved.coupled_positions) is followed by
+    no correction: its mid-stroke mismatch only (every increment's, a whole-grid stack read and transformed, was
+    5 % of a 3D resolved run, for the one the defect uses)."""
+    if coupled:
+        return _defect(member, wear_moving, wear_stationary, step, w_lin, tally, p_mid, travel_mid,
+                       correction[mid] if correction is not None else None)
     ahead = mismatch_rows(tally, member, stacks[3], *stacks[:3], step, w_lin) if stacks else None
     defect, mismatch = _defect(member, wear_moving, wear_stationary, step, w_lin, tally, p_mid, travel_mid,
                                correction[mid] if member.resolved and correction is not None else correction,

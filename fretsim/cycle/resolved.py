@@ -645,7 +645,7 @@ class Coupling:
             vh -= x1
             vh -= r[:m, None, :] * x2
             vh *= inv_c
-            return win.backward(vh).astype(float) if SINGLE else win.backward(vh)
+            return win.backward(vh)  # (float32 where SINGLE: the caller's product with the mask promotes it exactly)
         return apply
 
 
