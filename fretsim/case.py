@@ -243,7 +243,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
                                 "of the cycle with the moving body where it is over the worn flat (resolved); "
                                 "auto: with model.slip coulomb on a line contact, resolved where 2D proxy runs "
                                 "show the mid-stroke depths or widths more than model.accuracy/3 away (its loop costs "
-                                "about 3-3.5× the mid-stroke run's in 2D, 6× in 3D: README), else mid_stroke (uniform slip, partial slip, "
+                                "about 2.5× the mid-stroke run's in 2D, 3× in 3D: README), else mid_stroke (uniform slip, partial slip, "
                                 "point contacts: said why); resolved needs loading.friction_coefficient",
                       "auto",
                       choices=STROKE_MODELS),

@@ -202,8 +202,8 @@ def choose_stroke(case: Case, slip: str, regime_: Regime, runs, plan_case) -> Ch
         return Choice("model.stroke", family.RESOLVED,
                       f"{proxy} report {what} {diff:.2%} away from the mid-stroke model, more than model.accuracy "
                       f"{case.accuracy:.2%} / {PROXY_MARGIN:g} (a proxy's difference is itself uncertain): the "
-                      f"contact over the worn flat at each position of the stroke (its loop about 3-3.5× the cost in "
-                      f"2D, 6× in 3D)")
+                      f"contact over the worn flat at each position of the stroke (its loop about 2.5× the cost in "
+                      f"2D, 3× in 3D)")
     return Choice("model.stroke", family.MID_STROKE,
                   f"{held}: {proxy} report {what} within {diff:.2%} of the resolved stroke, within "
                   f"model.accuracy {case.accuracy:.2%} / {PROXY_MARGIN:g}", error=diff * PROXY_MARGIN)
