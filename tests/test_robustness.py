@@ -188,8 +188,12 @@ LONG = ["--set", "model.dimension=2d", "--set", "jumping.scheme=linear", "--set"
 
 def _kill_at(tmp_path, sig, rows, name):
     out = tmp_path / f"{name}.h5"
+    # (SIGINT restored to its default in the child: a background job, and an xdist worker, ignore it, and Python
+    #  keeps an inherited SIG_IGN, so the run never saw the Ctrl-C and completed: exit 0 in `pytest -m slow -n 2`
+    #  started in the background)
     proc = subprocess.Popen([sys.executable, "-m", "fretsim.cli", "run", str(CASES / "mccoll_185N.yaml"), "-o",
-                             str(out), *LONG], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE)
+                             str(out), *LONG], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_DFL))
     deadline = time.monotonic() + 60
     while time.monotonic() < deadline:
         try:
