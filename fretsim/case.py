@@ -251,7 +251,7 @@ SCHEMA: dict[str, dict[str, Key]] = {
                                   "materials.*.energy_wear_coefficient and loading.friction_coefficient)",
                         "archard", choices=Names(WEAR_LAWS)),
         "increments": Key("integer", "increments per half-stroke of the cycle (coulomb; odd: one is centred on "
-                                     "mid-stroke), or auto: 5 with the stroke resolved in gross slip, δ ≥ 5δ_t "
+                                     "mid-stroke), or auto: 5 with the stroke resolved in gross slip, δ ≥ 5δ_t, without fatigue "
                                      "(McColl's cases within 0.1 % in depth of 27 increments, 2D and 3D), else 9 (at "
                                      "mid-stroke they only draw the loop and sample a fatigue state's cycle)", None, lo=1,
                           hi=1001)},

@@ -44,6 +44,9 @@ class RowMatrix:
             raise ValueError("a RowMatrix's rows must be ascending")
         if max(shape) >= 2 ** 31 or rows.size >= 2 ** 31:
             raise ValueError("a RowMatrix this large needs 64-bit indices")
+        if rows.size and (rows[0] < 0 or rows[-1] >= shape[0] or cols.min() < 0 or cols.max() >= shape[1]):
+            raise ValueError("a RowMatrix's entries must lie in its shape")  # (the kernel does not check: it would
+            #                                                                   read and write past the arrays)
         self.shape = shape
         self.rows, self.indices = rows.astype(np.int32), cols.astype(np.int32)
         self.indptr = np.zeros(shape[0] + 1, np.int32)
@@ -62,6 +65,8 @@ def scatter_add(rows: np.ndarray, cols: np.ndarray, values: np.ndarray, x: np.nd
     """y (``size``) with y[rows[k]] += values[k]·x[cols[k]] over the entries in order: a sparse matrix's product
     from its entries, unsorted (numpy's bincount of the products: the same sums in the same order, where
     sparsetools' coo_matvec saves the products' array and is 1.7x faster)."""
+    if rows.size and (rows.min() < 0 or rows.max() >= size or cols.min() < 0 or cols.max() >= x.size):
+        raise ValueError("scatter_add's entries must lie in y and x")  # (the kernel does not check)
     return _kernels()[2](rows, cols, np.ascontiguousarray(values, float), np.ascontiguousarray(x, float), size)
 
 

@@ -60,9 +60,18 @@ def test_without_scipys_kernels_numpys_products_stand_in_with_the_same_numbers(m
     assert np.array_equal(native.scatter_add(a.rows, a.indices, values, x, 30), want_scatter)
 
 
-def test_a_row_matrix_refuses_rows_out_of_order():
+def test_a_row_matrix_refuses_rows_out_of_order_and_entries_outside_its_shape():
+    # (the compiled kernel does not check its indices: outside the arrays it read garbage and crashed the process)
     with pytest.raises(ValueError, match="ascending"):
         native.RowMatrix(np.array([0, 2, 1]), np.array([0, 0, 0]), (3, 1))
+    with pytest.raises(ValueError, match="shape"):
+        native.RowMatrix(np.array([0, 1]), np.array([0, 5]), (2, 3))
+    with pytest.raises(ValueError, match="shape"):
+        native.RowMatrix(np.array([0, 2]), np.array([0, 1]), (2, 3))
+    with pytest.raises(ValueError, match="lie in"):
+        native.scatter_add(np.array([0, 7]), np.array([0, 1]), np.ones(2), np.ones(2), 3)
+    with pytest.raises(ValueError, match="lie in"):
+        native.scatter_add(np.array([0, 1]), np.array([0, 2]), np.ones(2), np.ones(2), 3)
 
 
 def test_a_resolved_run_imports_no_scipy_package():

@@ -220,3 +220,8 @@ def test_increments_auto_takes_five_for_a_resolved_gross_slip_stroke_and_nine_el
     assert chosen("model.stroke=resolved", "loading.stroke=3.5 um") == 5  # (5.2 δ_t)
     assert chosen("model.stroke=mid_stroke") == 9
     assert chosen("model.stroke=resolved", "model.increments=7") == 7
+    # fatigue samples its stress history at the increments: 9 in gross slip too (the Ti-6Al-4V case at 40 µm had
+    # its Miner's sum 32 % low at 5 against 27, 2.6 % at 9)
+    _, filled, _ = prepare(load_case(CASES / "ti_fretting_fatigue.yaml", ["model.stroke=resolved",
+                                                                          "loading.stroke=40 um"]))
+    assert filled.increments == 9
