@@ -317,9 +317,6 @@ def _init_worker(parent: int = 0) -> None:
         os.environ[var] = "1"
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent stops the sweep; workers are ended by SIGTERM
     signal.signal(signal.SIGTERM, _on_terminate)
-    if hasattr(signal, "pthread_sigmask"):  # (forked with both held, _submit_held: a SIGTERM that came while the
-        #                                     worker still had the parent's handler waited for this one)
-        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
     global _PARENT
     _PARENT = parent or os.getppid()
     _die_with(_PARENT)
@@ -533,9 +530,7 @@ def _submit_held(pool, tasks: list) -> list:
     the forks are done, as a KeyboardInterrupt here, and the sweep stops as it does at any other moment."""
     import threading
     hold = hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
-    # SIGTERM held too: the workers inherit the mask, and one the parent ended while it was still starting (with the
-    # parent's handler, before _init_worker's) printed a KeyboardInterrupt traceback from multiprocessing's bootstrap
-    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM}) if hold else None
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if hold else None
     try:
         return [pool.submit(run_point, t) for t in tasks]
     finally:
