@@ -317,6 +317,9 @@ def _init_worker(parent: int = 0) -> None:
         os.environ[var] = "1"
     signal.signal(signal.SIGINT, signal.SIG_IGN)  # the parent stops the sweep; workers are ended by SIGTERM
     signal.signal(signal.SIGTERM, _on_terminate)
+    if hasattr(signal, "pthread_sigmask"):  # (forked with both held, _submit_held: a SIGTERM that came while the
+        #                                     worker still had the parent's handler waited for this one)
+        signal.pthread_sigmask(signal.SIG_UNBLOCK, {signal.SIGINT, signal.SIGTERM})
     global _PARENT
     _PARENT = parent or os.getppid()
     _die_with(_PARENT)
@@ -514,13 +517,28 @@ def _run_local(tasks: list, jobs: int, progress) -> list:
     except BaseException:
         workers = list((getattr(pool, "_processes", None) or {}).values())  # shutdown forgets them
         pool.shutdown(wait=False, cancel_futures=True)
-        for proc in workers:
-            proc.terminate()  # SIGTERM: a running point records itself as interrupted, and resumes next time
-        for proc in workers:
-            proc.join(timeout=60)  # its last write done before the table reads its file
+        _end_workers(workers)
         raise
     pool.shutdown(wait=True)
     return results
+
+
+def _end_workers(workers: list, patience: float = 60.0) -> None:
+    """SIGTERM to each worker, repeated until it is gone (or `patience` seconds): a running point records itself as
+    interrupted (and resumes next time), an idle worker leaves.  Repeated because one signal is not always enough:
+    a worker that took it inside a point returns to the queue when the point is written, and there waits forever
+    on the queue's lock if another worker was ended holding it (seen in CI as a sweep that never exited); and where
+    signals cannot be held while the pool forks (:func:`_submit_held`), a worker signalled in the instant after its
+    fork loses the signal (Python clears what arrived before its fork handling)."""
+    import time
+    deadline = time.monotonic() + patience
+    alive = list(workers)
+    while alive and time.monotonic() < deadline:
+        for proc in alive:
+            proc.terminate()
+        for proc in alive:
+            proc.join(timeout=0.5)  # its last write done before the table reads its file
+        alive = [proc for proc in alive if proc.is_alive()]
 
 
 def _submit_held(pool, tasks: list) -> list:
@@ -530,7 +548,9 @@ def _submit_held(pool, tasks: list) -> list:
     the forks are done, as a KeyboardInterrupt here, and the sweep stops as it does at any other moment."""
     import threading
     hold = hasattr(signal, "pthread_sigmask") and threading.current_thread() is threading.main_thread()
-    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT}) if hold else None
+    # SIGTERM held too: the workers inherit the mask, and one the parent ended while it was still starting (with the
+    # parent's handler, before _init_worker's) printed a KeyboardInterrupt traceback from multiprocessing's bootstrap
+    before = signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGINT, signal.SIGTERM}) if hold else None
     try:
         return [pool.submit(run_point, t) for t in tasks]
     finally:
