@@ -15,6 +15,12 @@ contact: time and CG iterations per solve, beside a cold solve of the first step
 ``--few`` instead: the cost model of Convolution.of_few (a solver step's few clipped or admitted elements applied
 by their kernel columns, not a transform) against its measurements — a 9-layer stack on 27 × 395, 27 × 120 and
 1 × 300 windows, the transform's time and the columns' at 1, 10, 50 and 300 elements, and which the model picks.
+
+``--single`` instead: the normal solver's single-precision phase (solvers/cg.py, SINGLE_UNTIL and
+SINGLE_PRECONDITIONER) against double throughout, in this process, alternately, medians of 5: single solves on
+3D grids, then whole runs (McColl 185 N 3D under the defaults and on the paper's grid without estimates, Kirk
+450 N 3D, the partial-slip ball, McColl 185 N 3D in Coulomb slip), with the largest relative difference of the
+summary's depths, widths and estimates.  Writes scripts/results/bench_contact_single.txt.
 """
 import os
 
@@ -156,14 +162,75 @@ def few() -> None:
                   f"{'columns' if picks else 'transform':>12s}  {'yes' if picks == (t < t_fft) else 'no'}")
 
 
+def single() -> None:
+    import fretsim.solvers.cg as cg
+    from fretsim.api import load_case, run
+    modes = {"double": (np.inf, False), "single": (cg.SINGLE_UNTIL, cg.SINGLE_PRECONDITIONER)}
+    lines = []
+
+    def say(text=""):
+        print(text, flush=True)
+        lines.append(text)
+
+    def paired(fn, reps=5):
+        times, outs = {m: [] for m in modes}, {}
+        for _ in range(reps):
+            for m, (until, pre) in modes.items():
+                cg.SINGLE_UNTIL, cg.SINGLE_PRECONDITIONER = until, pre
+                t = time.perf_counter()
+                outs[m] = fn()
+                times[m].append(time.perf_counter() - t)
+        cg.SINGLE_UNTIL, cg.SINGLE_PRECONDITIONER = modes["single"]
+        return {m: float(np.median(v)) for m, v in times.items()}, outs
+
+    say("single-precision phase of the normal CG against double throughout (medians of 5, alternately)")
+    say(f"{'problem':34s} {'double s':>9s} {'single s':>9s} {'ratio':>6s} {'iter d/s':>9s} {'max diff':>9s}")
+    ball = hertz_point(185.0, 6.0, E_STAR)
+    line = hertz_line(18.5, 6.0, E_STAR)
+    for name, grid, gap in [
+            *[(f"ball {n} × {n}", g, (g.mesh()[0] ** 2 + g.mesh()[1] ** 2) / 12.0) for n in (64, 128, 256)
+              for g in [Grid.centred(n, n, 3 * ball.radius / n, 3 * ball.radius / n)]],
+            *[(f"finite cylinder {nx} × {ny}", g, g.mesh()[0] ** 2 / 12.0) for nx, ny in ((117, 27), (427, 27))
+              for g in [Grid.centred(nx, ny, 7 * line.half_width / nx * 3, 10.0 / ny)]]]:
+        op = Compliance(grid, E_STAR)
+        t, outs = paired(lambda: solve(op, gap, 185.0))
+        diff = np.abs(outs["single"].pressure - outs["double"].pressure).max() / outs["double"].pressure.max()
+        say(f"{name:34s} {t['double']:9.4f} {t['single']:9.4f} {t['single'] / t['double']:6.3f} "
+            f"{outs['double'].iterations:4d}/{outs['single'].iterations:<4d} {diff:9.1e}")
+    say()
+    say(f"{'whole run (in process)':34s} {'double s':>9s} {'single s':>9s} {'ratio':>6s} {'solves':>9s} {'max diff':>9s}")
+    root = Path(__file__).resolve().parent.parent / "cases"
+    for name, file, sets in [("McColl 185 N 3D, defaults", "mccoll_185N.yaml", []),
+                             ("McColl 185 N 3D, paper grid, no est.", "mccoll_185N.yaml",
+                              ["grid.rule=paper", "grid.error_estimate=none"]),
+                             ("Kirk 450 N 3D, defaults", "kirk_450N_20Hz.yaml", []),
+                             ("ball in partial slip, defaults", "ball_partial_slip.yaml", []),
+                             ("McColl 185 N 3D, Coulomb", "mccoll_185N.yaml", ["loading.friction_coefficient=0.9"])]:
+        case = load_case(root / file, sets)
+        t, outs = paired(lambda: run(case))
+        s0, s1 = outs["double"].summary, outs["single"].summary
+        keys = [k for k, v in s0.items() if k.startswith(("centre_wear_depth", "max_wear_depth", "scar_width",
+                                                           "wear_volume", "estimated_error"))
+                and isinstance(v, float) and v == v and v != 0]
+        diff = max(abs(s1[k] - s0[k]) / abs(s0[k]) for k in keys)
+        say(f"{name:34s} {t['double']:9.3f} {t['single']:9.3f} {t['single'] / t['double']:6.3f} "
+            f"{s0['contact_solves']:4d}/{s1['contact_solves']:<4d} {diff:9.1e}")
+    out = Path(__file__).resolve().parent / "results" / "bench_contact_single.txt"
+    out.write_text("Command: python scripts/bench_contact.py --single\n\n" + "\n".join(lines) + "\n")
+    print(f"# wrote {out}")
+
+
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--quick", action="store_true", help="small grids only (a smoke run)")
     ap.add_argument("--few", action="store_true", help="Convolution.of_few's cost model against its times")
+    ap.add_argument("--single", action="store_true", help="the CG's single-precision phase against double")
     ap.add_argument("--out", default=str(Path(__file__).resolve().parent / "out"))
     args = ap.parse_args()
     if args.few:
         return few()
+    if args.single:
+        return single()
     out = Path(args.out)
     out.mkdir(parents=True, exist_ok=True)
     peers = peers_available()

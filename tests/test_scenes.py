@@ -76,8 +76,13 @@ def test_crossed_cylinders_of_equal_radii_are_a_ball_of_that_radius():
     wire = run(load_case(CASES / "wire_rope.yaml", base))
     ball = run(load_case(CASES / "wire_rope.yaml", [*base, "geometry.type=ball_on_flat",
                                                     "geometry.radius_stationary=", "geometry.sliding="]))
-    for key in ("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "max_pressure_MPa"):
-        assert wire.summary[key] == pytest.approx(ball.summary[key], rel=1e-12)
+    # not to round-off: the two gaps differ by round-off (1e-16), which the contact solver's early iterations in
+    # single precision (solvers/cg.py) carry to ~1e-11 of the depths (1.7e-11 measured) and ~1e-7 of the peak
+    # pressure, one edge-sensitive element (2.4e-8 measured; its complementarity tolerance is 1e-6); in double
+    # throughout all three held 1e-12.  A gap that differed in substance would move them by far more
+    for key in ("max_wear_depth_moving_um", "max_wear_depth_stationary_um"):
+        assert wire.summary[key] == pytest.approx(ball.summary[key], rel=1e-9)
+    assert wire.summary["max_pressure_MPa"] == pytest.approx(ball.summary["max_pressure_MPa"], rel=1e-6)
 
 
 def test_the_seat_rails_flat_scar_is_drawn_out_by_the_stroke_and_the_balls_is_round():
