@@ -2,7 +2,9 @@
 
 The solver's inner loops use two of scipy's extension modules: pocketfft (the transforms,
 :mod:`fretsim.compliance.fft`) and sparsetools (the resolved stroke's sparse read and deposit,
-:func:`row_matrix`).  Their packages cost far more to import than the kernels do to load: ``import scipy.fft``
+:func:`row_matrix`); planning a free-faces case uses LAPACK's banded Cholesky and generalised symmetric eigenvalues
+(:func:`banded_cholesky_solve`, :func:`generalized_eigenvalues`, from scipy's ``_flapack``; ``import scipy.linalg``
+is 0.13 s).  Their packages cost far more to import than the kernels do to load: ``import scipy.fft``
 0.2-0.3 s (scipy.special, the array-API layer), ``import scipy.sparse`` 0.13-0.2 s (the array-API layer and
 numpy.f2py) — a fifth of a 2D resolved run, paid again by every process of a sweep.  The extension modules load
 in under a millisecond and need neither.  Each is loaded from its file where scipy keeps it and checked against
@@ -127,3 +129,50 @@ def _agrees(dot, dot_transposed, scatter) -> bool:
                             atol=1e-14) and
                 np.array_equal(scatter(rows[shuffled], a.indices[shuffled].astype(np.int64), values[shuffled], x, 9),
                                _numpy_scatter_add(rows[shuffled], a.indices[shuffled], values[shuffled], x, 9)))
+
+
+# --- LAPACK (scipy.linalg's own wrappers, loaded from their file) ------------------------------------------------
+
+_LAPACK: Optional[object] = None
+
+
+def _lapack():
+    """scipy's ``_flapack`` from its file, or scipy.linalg.lapack itself where that cannot be loaded (the same
+    routines; only the import costs more)."""
+    global _LAPACK
+    if _LAPACK is None:
+        try:
+            _LAPACK = load("linalg/_flapack", "scipy.linalg._flapack")
+        except Exception:  # noqa: BLE001 - any problem with the private module means: the public one
+            _LAPACK = None
+        if _LAPACK is None or not all(hasattr(_LAPACK, f) for f in ("dpbtrf", "dpbtrs", "dsygvd")):
+            import scipy.linalg.lapack as _LAPACK_PUBLIC
+            _LAPACK = _LAPACK_PUBLIC
+    return _LAPACK
+
+
+def banded_cholesky_solve(ab: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """x with A x = b for A symmetric positive definite in LAPACK's upper band storage ``ab`` (band + 1, n), as
+    scipy.linalg's cholesky_banded and cho_solve_banded compute it (dpbtrf, dpbtrs); ``ab`` is overwritten.
+    numpy.linalg.LinAlgError where A is not positive definite."""
+    lapack = _lapack()
+    c, info = lapack.dpbtrf(ab, lower=0, overwrite_ab=1)
+    if info > 0:
+        raise np.linalg.LinAlgError(f"the {info}-th leading minor of a banded matrix is not positive definite")
+    if info < 0:
+        raise ValueError(f"dpbtrf: illegal value in argument {-info}")
+    x, info = lapack.dpbtrs(c, b, lower=0)
+    if info != 0:
+        raise ValueError(f"dpbtrs: illegal value in argument {-info}")
+    return x
+
+
+def generalized_eigenvalues(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """The eigenvalues, ascending, of a v = λ b v for a symmetric and b symmetric positive definite (their lower
+    triangles read), as scipy.linalg.eigh(a, b, eigvals_only=True) computes them (dsygvd).  numpy.linalg.LinAlgError
+    where b is not positive definite or the iteration fails."""
+    w, _, info = _lapack().dsygvd(a, b, itype=1, jobz="N", uplo="L")
+    if info != 0:
+        raise np.linalg.LinAlgError(f"dsygvd failed (info {info}): "
+                                    + ("b is not positive definite" if info > a.shape[0] else "no convergence"))
+    return w

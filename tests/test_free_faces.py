@@ -166,3 +166,27 @@ def test_the_fourier_integrals_monotone_cubic_is_scipys_pchip_and_keeps_the_data
         assert np.abs(pchip(xs, ys, x) - want).max() <= 1e-13 * np.abs(want).max()
         if trial % 5 == 0:
             assert (np.diff(pchip(xs, ys, np.linspace(xs[0], xs[-1], 257)), axis=0) >= -1e-12).all()
+
+
+@pytest.mark.parametrize("rows, mirrored", [(27, True), (26, True), (5, False), (1, True)])
+def test_the_kernel_along_x_from_half_the_rows_and_the_positive_lags_is_the_whole_sum(rows, mirrored):
+    """kernel_along_x computes the lags ≥ 0 and, where the rows are placed symmetrically (ΔG_ij = ΔG_(n−1−i)(n−1−j)),
+    the first half of the rows, and fills in the rest (a quarter of the work): the same as the whole sum written
+    out, ΔK_ij(s) = (1/π) Σ_k w_k ΔG_ij(k) B(k) cos(k s), at every lag of either sign and every pair of rows, to
+    round-off.  A sample that is not mirrored (5 rows, random) takes every row."""
+    from fretsim.compliance.free_faces import K_POINTS, pchip
+    rng = np.random.default_rng(rows)
+    ks = np.array([0.0, 0.1, 0.3, 1.0, 3.0, 10.0])
+    delta = rng.normal(size=(ks.size, rows, rows))
+    if mirrored:
+        delta = 0.5 * (delta + delta[:, ::-1, ::-1])
+    nx, dx = 59, 0.01
+    s = (np.arange(2 * nx - 1) - (nx - 1)) * dx
+    k = np.linspace(0.0, ks[-1], max(K_POINTS, int(ks[-1] * s[-1] / 0.05) + 1))
+    weights = np.full(k.size, k[1] - k[0])
+    weights[[0, -1]] *= 0.5
+    box = np.where(k > 0, 2 * np.sin(k * dx / 2) / np.where(k > 0, k, 1.0), dx)
+    whole = np.einsum("kij,k,ks->ijs", pchip(ks, delta, k), weights * box, np.cos(np.outer(k, s))) / np.pi
+    got = kernel_along_x(delta, ks, dx, nx)
+    assert got.shape == whole.shape
+    assert np.abs(got - whole).max() <= 1e-12 * np.abs(whole).max()

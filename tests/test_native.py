@@ -88,3 +88,44 @@ def test_a_resolved_run_imports_no_scipy_package():
     status, coupled, modules = out.stdout.strip().splitlines()[-1].split(" ", 2)
     assert status == "complete" and coupled == "True"  # (the coupled steps' products ran)
     assert modules == "[]", modules
+
+
+def test_lapacks_banded_cholesky_and_generalised_eigenvalues_are_scipy_linalgs_bit_for_bit():
+    """Loaded from scipy's _flapack file, the free faces' banded solve and the window spectrum's eigenvalues are the
+    very routines scipy.linalg calls (dpbtrf/dpbtrs, dsygvd): the same numbers bit for bit; a matrix that is not
+    positive definite is refused, not solved."""
+    import scipy.linalg as sla
+    rng = np.random.default_rng(3)
+    n, band = 120, 6
+    a = np.zeros((n, n))
+    for d in range(band + 1):
+        v = rng.normal(size=n - d)
+        a += np.diag(v, d) + (np.diag(v, -d) if d else 0.0)
+    a += 3 * (2 * band + 5) * np.eye(n)
+    ab = np.zeros((band + 1, n))
+    for d in range(band + 1):
+        ab[band - d, d:] = np.diag(a, d)
+    b = rng.normal(size=(n, 4))
+    ref = sla.cho_solve_banded((sla.cholesky_banded(ab.copy(), check_finite=False), False), b, check_finite=False)
+    assert np.array_equal(native.banded_cholesky_solve(ab.copy(), b), ref)
+    assert np.abs(a @ ref - b).max() < 1e-12
+    m = rng.normal(size=(40, 40))
+    c, w = m @ m.T + 40 * np.eye(40), m + m.T
+    assert np.array_equal(native.generalized_eigenvalues(w, c), sla.eigh(w, c, eigvals_only=True))
+    with pytest.raises(np.linalg.LinAlgError):
+        native.banded_cholesky_solve(-ab.copy(), b)
+    with pytest.raises(np.linalg.LinAlgError):
+        native.generalized_eigenvalues(w, -c)
+
+
+def test_planning_a_free_faces_case_imports_no_scipy_package():
+    """`check` of McColl 185 N with the free faces (two 3D proxies, the faces' finite-element blocks, the window
+    spectrum) in a fresh process: LAPACK loaded from its file; ``import scipy.linalg`` (0.13 s) was an eighth of it."""
+    code = ("import sys; from fretsim.api import load_case; from fretsim.plan import prepare; "
+            f"setup, filled, plan = prepare(load_case({str(CASES / 'mccoll_185N_free_faces.yaml')!r})); "
+            "print('free_faces' in str(filled.to_dict()), "
+            "sorted(m for m in sys.modules if m.startswith('scipy') and not m.endswith(('_flapack', 'pypocketfft'))))")
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True, cwd=CASES)
+    kept, modules = out.stdout.strip().splitlines()[-1].split(" ", 1)
+    assert kept == "True"  # (auto kept the faces: their blocks and spectrum were computed)
+    assert modules == "[]", modules

@@ -172,3 +172,34 @@ def test_a_resolved_strokes_growing_pattern_is_reported_with_its_own_cause_and_w
     assert "resolved stroke" in resolved and "jumping.tolerance" in resolved and "model.stroke: mid_stroke" in resolved
     mid = model_growth_cause(SimpleNamespace(resolved=False, rigid=False, linear=False, name="coulomb"), None)
     assert "resolved" not in mid and "grid.elements" in mid
+
+
+def _mirror_average(a: np.ndarray, my: int, mx: int) -> np.ndarray:
+    a4 = a.reshape(my, mx, my, mx)
+    a4 = 0.5 * (a4 + a4[::-1, :, ::-1, :])
+    a4 = 0.5 * (a4 + a4[:, ::-1, :, ::-1])
+    return a4.reshape(my * mx, my * mx)
+
+
+@pytest.mark.parametrize("shape, mirrored", [((9, 48), True), ((4, 7), True), ((1, 12), True), ((5, 1), True),
+                                             ((3, 6), False)])
+def test_the_window_eigenvalues_by_reflection_classes_are_the_whole_problems(shape, mirrored):
+    """window_eigenvalues splits W v = μ C v over zero-sum changes into the four classes of modes even or odd along
+    x and y where both matrices commute with the window's reflections (6× faster on 9 × 48): the same eigenvalues,
+    as many, as the whole problem on an orthonormal basis of the zero-sum changes (QR, as it was solved before), to
+    1e-9 of the largest; a pair without the symmetry (random) takes the whole problem."""
+    import scipy.linalg as sla
+    from fretsim.stability import window_eigenvalues
+    my, mx = shape
+    n = my * mx
+    rng = np.random.default_rng(n)
+    a, b = rng.normal(size=(n, n)), rng.normal(size=(n, n))
+    c = a @ a.T + n * np.eye(n)
+    w = b + b.T
+    if mirrored:
+        c, w = _mirror_average(c, my, mx), _mirror_average(w, my, mx)
+    q = np.linalg.qr(np.column_stack([np.ones(n), np.eye(n)[:, :n - 1]]))[0][:, 1:]
+    whole = np.sort(sla.eigh(q.T @ w @ q, q.T @ c @ q, eigvals_only=True))
+    got = np.sort(window_eigenvalues(w, c, shape))
+    assert got.shape == whole.shape == (n - 1,)
+    assert np.abs(got - whole).max() <= 1e-9 * np.abs(whole).max()
