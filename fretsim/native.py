@@ -155,6 +155,8 @@ def banded_cholesky_solve(ab: np.ndarray, b: np.ndarray) -> np.ndarray:
     """x with A x = b for A symmetric positive definite in LAPACK's upper band storage ``ab`` (band + 1, n), as
     scipy.linalg's cholesky_banded and cho_solve_banded compute it (dpbtrf, dpbtrs); ``ab`` is overwritten.
     numpy.linalg.LinAlgError where A is not positive definite."""
+    if b.shape[0] != ab.shape[1]:
+        raise ValueError(f"the right-hand side has {b.shape[0]} rows for a matrix of order {ab.shape[1]}")
     lapack = _lapack()
     c, info = lapack.dpbtrf(ab, lower=0, overwrite_ab=1)
     if info > 0:

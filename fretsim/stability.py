@@ -90,6 +90,9 @@ def window_eigenvalues(w: np.ndarray, c: np.ndarray, shape: tuple) -> np.ndarray
     proxies).  Otherwise the whole problem."""
     from fretsim.native import generalized_eigenvalues
     my, mx = shape
+    # symmetric parts: a free-faces C is symmetric to ~5e-7 only, and LAPACK reads one triangle, so without this
+    # the eigenvalues depended (by ~1e-8) on the basis they were computed in
+    w, c = 0.5 * (w + w.T), 0.5 * (c + c.T)
     w4, c4 = w.reshape(my, mx, my, mx), c.reshape(my, mx, my, mx)
     if not (_mirrored(w4) and _mirrored(c4)):
         q = _zero_sum_basis(np.ones(w.shape[0]))
@@ -107,7 +110,7 @@ def window_eigenvalues(w: np.ndarray, c: np.ndarray, shape: tuple) -> np.ndarray
                     continue
                 wc, cc = q.T @ wc @ q, q.T @ cc @ q
             out.append(generalized_eigenvalues(wc, cc))
-    return np.concatenate(out)
+    return np.concatenate(out) if out else np.zeros(0)
 
 
 def _mirrored(a4: np.ndarray) -> bool:

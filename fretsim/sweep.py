@@ -539,6 +539,9 @@ def _end_workers(workers: list, patience: float = 60.0) -> None:
         for proc in alive:
             proc.join(timeout=0.5)  # its last write done before the table reads its file
         alive = [proc for proc in alive if proc.is_alive()]
+    for proc in alive:  # one that never took SIGTERM (still starting, with it held: _submit_held) is not left
+        proc.kill()     # behind: its point's file, if any, stays as last written (a resume continues from it)
+        proc.join(timeout=5)
 
 
 def _submit_held(pool, tasks: list) -> list:

@@ -165,7 +165,7 @@ def few() -> None:
 def single() -> None:
     import fretsim.solvers.cg as cg
     from fretsim.api import load_case, run
-    modes = {"double": (np.inf, False), "single": (cg.SINGLE_UNTIL, cg.SINGLE_PRECONDITIONER)}
+    modes = {"double": (0.0, False), "single": (cg.SINGLE_UNTIL, cg.SINGLE_PRECONDITIONER)}  # (0: no single phase)
     lines = []
 
     def say(text=""):

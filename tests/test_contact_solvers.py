@@ -101,12 +101,20 @@ def test_cg_with_single_precision_directions_finds_the_double_solvers_pressures(
                "line": lambda: line_problem(300)}[problem]()
     load = 18.5 if problem == "line" else 185.0
     fast = solve(op, gap, load, method="cg")
-    monkeypatch.setattr(cg, "SINGLE_UNTIL", np.inf)
+    monkeypatch.setattr(cg, "SINGLE_UNTIL", 0.0)  # (0: double from the start)
     monkeypatch.setattr(cg, "SINGLE_PRECONDITIONER", False)
     double = solve(op, gap, load, method="cg")
     assert fast.success and double.success, (fast.message, double.message)
     if problem == "line":  # (2D stays in double: its transforms are too short to gain)
         assert np.array_equal(fast.pressure, double.pressure)
+    else:  # (and the single phase did run, and hand over to double: its preconditioner is double again after)
+        monkeypatch.setattr(cg, "SINGLE_UNTIL", 1e-5)
+        monkeypatch.setattr(cg, "SINGLE_PRECONDITIONER", True)
+        seen = []
+        real = cg._preconditioner
+        monkeypatch.setattr(cg, "_preconditioner", lambda c, single=False: seen.append(single) or real(c, single))
+        solve(op, gap, load, method="cg")
+        assert seen == [True, False]
     assert np.abs(fast.pressure - double.pressure).max() <= 1e-8 * double.pressure.max()
     assert abs(fast.iterations - double.iterations) <= 2
     assert fast.residual <= 1e-6

@@ -327,6 +327,34 @@ def test_ending_the_workers_signals_again_one_that_carried_on_after_the_first_si
         proc.join()
 
 
+def _never_leave(ready):
+    """A worker that never takes SIGTERM (one still starting, with the signal held while the pool forked)."""
+    signal.pthread_sigmask(signal.SIG_BLOCK, {signal.SIGTERM})
+    ready.set()
+    while True:
+        time.sleep(0.01)
+
+
+@pytest.mark.skipif("fork" not in __import__("multiprocessing").get_all_start_methods()
+                    or not hasattr(signal, "pthread_sigmask"), reason="forks, signal masks")
+def test_ending_the_workers_kills_one_that_never_takes_sigterm_when_patience_runs_out():
+    """A worker stuck before its initializer keeps SIGTERM held (found by review): it is killed when the patience
+    runs out, not left running after the sweep."""
+    import multiprocessing as mp
+    from fretsim.sweep import _end_workers
+    ctx = mp.get_context("fork")
+    ready = ctx.Event()
+    proc = ctx.Process(target=_never_leave, args=(ready,))
+    proc.start()
+    try:
+        assert ready.wait(30)
+        _end_workers([proc], patience=1.5)
+        assert not proc.is_alive() and proc.exitcode == -signal.SIGKILL
+    finally:
+        proc.kill()
+        proc.join()
+
+
 def _children(pid: int) -> list:
     """The processes whose parent is ``pid`` (Linux /proc)."""
     out = []

@@ -33,13 +33,14 @@ SINGLE_PRECONDITIONER = True
 SINGLE_UNTIL = 1e-5
 
 
-def _preconditioner(compliance):
+def _preconditioner(compliance, single: bool = False):
+    """The preconditioner (None without a convolution part); ``single``: in single precision (float32 out)."""
     conv = getattr(compliance, "convolution", None)
     if conv is None:
         return None
     hat = conv.hat.real if np.iscomplexobj(conv.hat) else conv.hat
     inv = 1.0 / np.maximum(hat, 1e-3 * float(hat.max()))
-    if SINGLE_PRECONDITIONER and conv.grid.shape[0] > 1:
+    if single:
         inv32 = inv.astype(np.float32)
         return lambda v: conv.backward(conv.forward(v.astype(np.float32)) * inv32)
     return lambda v: conv.backward(conv.forward(v) * inv)
@@ -69,7 +70,9 @@ def solve_cg(compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] 
     allowed = np.isfinite(gap)
     h = np.where(allowed, gap, 0.0)
     max_iter = max_iter or max(1000, 5 * int(np.sqrt(gap.size)) + 200)
-    precond = _preconditioner(compliance) if precondition else None
+    # (3D only: a 2D line's transforms are too short to gain, and 2D results keep their round-off symmetries)
+    single = hasattr(compliance, "single") and gap.shape[0] > 1 and SINGLE_UNTIL > 0
+    precond = _preconditioner(compliance, single and SINGLE_PRECONDITIONER) if precondition else None
     p = _start(p0, h, allowed, total)
     t = np.zeros_like(p)
     gz_old, delta, err = 1.0, 0.0, np.inf
@@ -77,8 +80,7 @@ def solve_cg(compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] 
     # the search directions' images in single precision (a 3D transform in double costs several times single's):
     # the displacement they update drifts by about 1e-7 of each step's change, so it is recomputed in double every
     # RECOMPUTE_EVERY iterations and before convergence is judged (PENETRATION is 1e-6), as in cg_coupled
-    # (3D only: a 2D line's transforms are too short to gain, and 2D results keep their round-off symmetries)
-    fast = compliance.single() if hasattr(compliance, "single") and gap.shape[0] > 1 else compliance
+    fast = compliance.single() if single else compliance
     complementary = False
     for it in range(1, max_iter + 1):
         on, m, count, g = _gradient(u, h, p)
@@ -112,8 +114,9 @@ def solve_cg(compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] 
         err = float(np.abs(p - p_old).sum()) / total
         if not np.isfinite(err):
             return ContactResult(p_old, 0.0, p_old > 0, it, False, f"cg: non-finite pressure at iteration {it}")
-        if err < SINGLE_UNTIL and fast is not compliance:  # the last iterations in double: single's round-off
-            fast, u = compliance, compliance(p)          # held a 60-element line's change at 1.6e-10 > tol
+        if err < SINGLE_UNTIL and single:  # the last iterations in double: single's round-off held a 60-element
+            single, fast, u = False, compliance, compliance(p)  # line's change at 1.6e-10 > tol
+            precond = _preconditioner(compliance) if precondition else None
         # (not in a step that admitted penetrating elements: it puts only a small pressure on them, so its change
         #  is small whatever is left to do — a window grown round a contact that moved stopped there with its gap
         #  off by a fifth of the displacement spread over the contact)
