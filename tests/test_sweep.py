@@ -1,4 +1,5 @@
 """Sweeps (issue #10): sweep files checked like cases, long-lived workers, a table, resumable, Dask."""
+import contextlib
 import csv
 import io
 import os
@@ -294,6 +295,22 @@ def test_a_ctrl_c_while_the_sweep_forks_its_workers_stops_the_sweep_without_a_tr
     assert any(r["status"] != "complete" for r in table(out))
 
 
+@contextlib.contextmanager
+def _forked(target):
+    """A forked process running ``target(ready)``, once it has said it is ready; killed at the end in any case."""
+    import multiprocessing as mp
+    ctx = mp.get_context("fork")
+    ready = ctx.Event()
+    proc = ctx.Process(target=target, args=(ready,))
+    proc.start()
+    try:
+        assert ready.wait(30)
+        yield proc
+    finally:
+        proc.kill()
+        proc.join()
+
+
 def _leave_on_second_sigterm(ready):
     """A worker that takes its first SIGTERM and carries on (as one inside a point does, and then waits on a queue
     lock another worker died holding)."""
@@ -310,21 +327,12 @@ def test_ending_the_workers_signals_again_one_that_carried_on_after_the_first_si
     SIGTERM inside a point went back to the queue and waited there on a lock another worker was ended holding.
     The sweep now signals again until each worker is gone; one SIGTERM and a join (as before) leaves this one
     running."""
-    import multiprocessing as mp
     from fretsim.sweep import _end_workers
-    ctx = mp.get_context("fork")
-    ready = ctx.Event()
-    proc = ctx.Process(target=_leave_on_second_sigterm, args=(ready,))
-    proc.start()
-    try:
-        assert ready.wait(30)
+    with _forked(_leave_on_second_sigterm) as proc:
         start = time.monotonic()
         _end_workers([proc], patience=20)
         assert not proc.is_alive() and proc.exitcode == 0
         assert time.monotonic() - start < 10  # two rounds of half a second, not the patience
-    finally:
-        proc.kill()
-        proc.join()
 
 
 def _never_leave(ready):
@@ -340,19 +348,10 @@ def _never_leave(ready):
 def test_ending_the_workers_kills_one_that_never_takes_sigterm_when_patience_runs_out():
     """A worker stuck before its initializer keeps SIGTERM held (found by review): it is killed when the patience
     runs out, not left running after the sweep."""
-    import multiprocessing as mp
     from fretsim.sweep import _end_workers
-    ctx = mp.get_context("fork")
-    ready = ctx.Event()
-    proc = ctx.Process(target=_never_leave, args=(ready,))
-    proc.start()
-    try:
-        assert ready.wait(30)
+    with _forked(_never_leave) as proc:
         _end_workers([proc], patience=1.5)
         assert not proc.is_alive() and proc.exitcode == -signal.SIGKILL
-    finally:
-        proc.kill()
-        proc.join()
 
 
 def _children(pid: int) -> list:
