@@ -80,8 +80,7 @@ def solve_cg(compliance, gap: np.ndarray, load: float, p0: Optional[np.ndarray] 
     # the search directions' images in single precision (a 3D transform in double costs several times single's):
     # the displacement they update drifts by about 1e-7 of each step's change, so it is recomputed in double every
     # RECOMPUTE_EVERY iterations and before convergence is judged (PENETRATION is 1e-6), as in cg_coupled
-    fast = compliance.single() if single else compliance
-    complementary = False
+    fast, complementary = compliance.single() if single else compliance, False
     for it in range(1, max_iter + 1):
         on, m, count, g = _gradient(u, h, p)
         t, gz = _direction(g, m, count, precond, t, delta, gz_old)
