@@ -4,7 +4,7 @@ Runs the scenario of tests/test_sweep.py's ``test_a_ctrl_c_while_the_sweep_forks
 from the parent's own at-fork hook, so it always lands during the forks) N times, P at once so that the machine is
 loaded and the workers start slowly, and classifies each run: exit 130 with no traceback (right), a traceback, another
 exit code, or a hang (no exit within the timeout; its process tree is then killed).  A race shows as a few bad runs
-in many: 2 of 4 clean-clone CI runs failed this test before the fix of 2026-11-28, and this script found 3 tracebacks
+in many: 2 of 4 clean-clone CI runs failed this test before the fix of 2026-11-28, and this script found 6 tracebacks
 and 2 hangs in 36 runs on that tree, none in 192 after it.
 
     python scripts/stress_sweep_signals.py [-n 48] [-p 4] [--timeout 60]
