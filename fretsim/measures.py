@@ -6,6 +6,8 @@ wherever it is reported.  Arrays are (My, Mx) fields on the grid, in mm.
 """
 from __future__ import annotations
 
+import math
+
 import numpy as np
 
 
@@ -33,23 +35,37 @@ def centre_width(depth: np.ndarray, x: np.ndarray) -> float:
 def scar_width(profile: np.ndarray, x: np.ndarray, fraction: float = 1e-3) -> float:
     """Width (mm) of the worn zone of a profile: where the depth exceeds ``fraction`` of its maximum.
 
-    Sub-element: the two crossings of the threshold are interpolated linearly between element centres, so
-    the width moves continuously with the grid instead of by whole elements.
+    Sub-element: each edge's crossing of the threshold lies between the last element centre above it (depth b)
+    and the first at or below it (depth a).  It is read as the later of
+    - the logarithm's linear interpolation between b and a (a tail that decays geometrically: the worn flat's,
+      whose stroke-averaged wear fades over several elements), none where a = 0;
+    - the secant through the last two centres above the threshold, continued (a profile that ends inside the
+      element: the moving body's, whose depth falls about linearly to the edge of its largest contact), but not
+      past the chord from b to a.
+    Both lie between the centres and vary continuously with a.  The chord alone (linear interpolation of the
+    depths), used before, put the edge up to a whole element outside it: 1.2-2.2 element widths of error in the
+    width against runs 4× finer, where this reading is within 0.3-1.0 (``scripts/study_width_error.py``).
     """
     peak = float(profile.max())
     if peak <= 0:
         return 0.0
     level = fraction * peak
     above = np.flatnonzero(profile > level)
-    i0, i1 = above[0], above[-1]
+    return _crossing(profile, x, level, above[-1], 1) - _crossing(profile, x, level, above[0], -1)
 
-    def crossing(i_in: int, i_out: int) -> float:
-        if i_out < 0 or i_out >= profile.size:
-            return float(x[i_in])
-        a, b = profile[i_out], profile[i_in]
-        return float(x[i_out] + (x[i_in] - x[i_out]) * (level - a) / (b - a))
 
-    return crossing(i1, i1 + 1) - crossing(i0, i0 - 1)
+def _crossing(profile: np.ndarray, x: np.ndarray, level: float, i_in: int, step: int) -> float:
+    """Where the depth falls through ``level`` between element ``i_in`` (above it) and its neighbour ``step`` on."""
+    i_out, i_prev = i_in + step, i_in - step
+    if i_out < 0 or i_out >= profile.size:
+        return float(x[i_in])
+    a, b = float(profile[i_out]), float(profile[i_in])
+    c = float(profile[i_prev]) if 0 <= i_prev < profile.size else b
+    chord = (b - level) / (b - a)
+    secant = (b - level) / (c - b) if c > b else chord
+    geometric = math.log(b / level) / math.log(b / a) if a > 0 else 0.0
+    t = min(max(geometric, min(secant, chord)), 1.0)
+    return float(x[i_in] + (x[i_out] - x[i_in]) * t)
 
 
 PERCENTILES = (10, 50, 90)  # what a sampled sweep reports of each value (percentiles.csv, the uncertainty figure)

@@ -19,11 +19,13 @@ from typing import Optional
 from fretsim.geometry import Geometry
 
 ELEMENTS_OVER_7A = 40  # paper Table 1
-# The reported scar widths are where the depth crosses 0.1 % of its peak.  Between element centres that crossing
-# is known to about half an element at each edge (scripts/study_grid_error.py: the widths' error at the paper's
-# grid is 1-2 %, about one element, and not monotone in the element size), so a width within model.accuracy
-# needs an element of at most accuracy/WIDTH_SHARE of the scar: a third of the accuracy for the element, the rest
-# for what the coarser companion grid sees (fretsim.grid_error).
+# The reported scar widths are where the depth crosses 0.1 % of its peak, read between element centres
+# (fretsim.measures.scar_width) to within an element: at most 0.28-0.49 element widths of error at the accuracy
+# grid and the two grids below it, 0.95 on grids 8× coarser (scripts/study_width_error.py).  The width's estimate
+# (fretsim.grid_error) is the stepping's part plus the larger of one element over the width and the companion's
+# difference, so a width within model.accuracy needs an element of at most accuracy/WIDTH_SHARE of the scar: a
+# third of the accuracy for the element, the rest for the stepping and a companion twice as coarse (measured:
+# estimates 0.59-0.75 % at accuracy 1 %; with a share of 2.1, 1 of 32 widths over).
 WIDTH_SHARE = 3.0
 MAX_ACCURACY_REFINEMENT = 4.0  # per axis, over the paper's rule: beyond it the cost grows faster than it pays
 # The pressure field's L2 error, as the companion grid estimates it, falls about as the element along x over the

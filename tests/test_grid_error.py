@@ -86,14 +86,34 @@ def test_a_converging_peak_is_read_from_the_nearer_difference_and_a_wandering_on
     assert not ok and est == pytest.approx(SQRT_H * 0.05)
 
 
-def test_the_papers_grid_gets_an_honest_width_estimate_beyond_the_accuracy_and_says_so():
-    """At the paper's 7a/40 the 2D widths are 1-2 % off (the issue's finding): the estimate must see it."""
+def _chord_width(profile, x, fraction=1e-3):
+    """The width as fretsim read it before 2026-11-28: each crossing interpolated linearly between centres."""
+    level = fraction * profile.max()
+    above = np.flatnonzero(profile > level)
+    lo, hi = above[0], above[-1]
+    right = x[hi + 1] + (x[hi] - x[hi + 1]) * (level - profile[hi + 1]) / (profile[hi] - profile[hi + 1])
+    left = x[lo - 1] + (x[lo] - x[lo - 1]) * (level - profile[lo - 1]) / (profile[lo] - profile[lo - 1])
+    return right - left
+
+
+def test_the_papers_grid_reads_its_widths_within_an_element_and_its_estimate_covers_them():
+    """McColl 1670 N in 2D at the paper's 7a/40 (dx/W ≈ 1.8 %), against 8× finer: the chord reading of the
+    crossing was 1.8 % off, the sub-element reading is within an element (measured 0.68 %) and closer than the
+    chord on both bodies; the estimate covers the error and, being over model.accuracy, is said."""
+    from fretsim.measures import centre_line
     out = run(load_case(CASES / "mccoll_1670N.yaml", ["model.dimension=2d", "grid.rule=paper"]))
     ref = _finer("mccoll_1670N", out, 8)
-    width = max(abs(out.summary[k] / ref.summary[k] - 1) for k in WIDTHS)
-    assert width > out.case.accuracy  # measured 1.8 %: the paper's grid misses 1 %
-    assert out.summary["estimated_error_width"] >= width
-    assert any("exceeds model.accuracy" in n for n in out.notes)
+    x, xr = out.setup.grid.x, ref.setup.grid.x
+    for body, key in (("wear_stationary", "scar_width_stationary_mm"), ("wear_moving", "scar_width_moving_mm")):
+        width, ref_width = out.summary[key], ref.summary[key]
+        element = out.setup.grid.dx / width
+        error = abs(width / ref_width - 1)
+        chord = abs(_chord_width(centre_line(getattr(out.last, body)), x)
+                    / _chord_width(centre_line(getattr(ref.last, body)), xr) - 1)
+        assert error < element and error < chord, (body, error, element, chord)
+        assert error <= out.summary["estimated_error_width"]
+    assert out.summary["estimated_error_width"] > out.case.accuracy
+    assert any("the scar widths" in n and "exceeds model.accuracy" in n for n in out.notes)
 
 
 def test_the_accuracy_rule_sizes_the_element_by_the_scar_and_the_paper_rule_by_the_contact():
