@@ -14,6 +14,12 @@ what to what, why).
 A grid the case gives (``grid.domain`` or ``grid.elements``) is the user's: it is never changed, and the run
 stops at the edge as it always did.
 
+**Starting small.**  An automatic grid that will coarsen (below) is planned on the domain of the scar at which it
+may first coarsen, not the final scar's, where that is smaller (:func:`fretsim.sizing.auto_grid`): the tube in
+service starts on 1.5 mm, not 8 mm, of 1.1 µm elements, and widens three times as its scar grows to 5.7 mm,
+coarsening twice on the way.  The side runs do the same (:func:`following` with ``widen``): a wear limit's pilot,
+and the grid-error companions, which start on the run's first domain with half (a quarter of) its elements.
+
 **Coarsening.**  The automatic grid resolves the *initial* contact (a tube's Hertz half-width of 6.5 µm), which is
 far finer than a scar millimetres wide needs: at an accepted step where the current contact and scar allow
 elements three times as long under the rules that sized the grid (the paper's 7c/40 on the current contact
@@ -39,10 +45,12 @@ from typing import Callable, Optional
 
 import numpy as np
 
+from fretsim.errors import DomainError
 from fretsim.grid import Grid
-
-COARSEN = 3  # elements merged into one: odd, so a centred odd grid stays centred and nested
-MAX_REGRIDS = 6  # each at least 1.6× the extent: 17× the planned extent in all, beyond which the plan was wrong
+from fretsim.sizing import COARSEN  # elements merged into one: odd, so a centred odd grid stays centred and nested
+MAX_REGRIDS = 12  # each at least 1.6× the extent: 280× the planned extent in all, beyond which the plan was wrong
+#                  (a grid that follows the contact plans to widen: a tube's pilot 7 times, from the 0.1 mm scar of
+#                  its first coarsening to the 6 mm of its limit)
 GROWTH = 0.3  # each side gains at least this share of the extent (and the stroke's reach): a few regrids at most
 
 
@@ -346,19 +354,46 @@ def step_down(setup, case, exc: Coarsen, prepare_fn: Callable, factor: int):
     return new_setup, new_case, plan, state, pad_r, made
 
 
-def following(run: Callable, setup, case, rule: Callable, prepare_fn: Callable):
-    """``run(setup, resume, coarsen)`` (a side run: a pilot, a companion) carried through its coarsenings: its last
+class _Last:
+    """An observer that keeps the last accepted step's checkpoint (a side run widens from it)."""
+
+    def __init__(self, state: Optional[dict] = None):
+        self.state = state
+
+    def on_step(self, setup, step) -> None:
+        self.state = step.state
+
+
+def following(run: Callable, setup, case, rule: Callable, prepare_fn: Callable, widen: bool = False):
+    """``run(setup, resume, coarsen, observers)`` (a side run: a pilot, a companion) carried through its
+    coarsenings, and, ``widen``, through the widenings of its automatic grid where the contact reaches its edge
+    (from its last accepted step, as the run's own: :mod:`fretsim.runner`), at most MAX_REGRIDS of them: its last
     step, the setup it ended on and the coarsenings made."""
-    state, made, factor = None, [], 1
+    state, made, factor, widenings = None, [], 1, 0
     while True:
+        last = _Last(state)
         try:
-            return run(setup, state, rule), setup, made
+            return run(setup, state, rule, (last,)), setup, made
         except Coarsen as exc:
             setup, case, _, state, _, c = step_down(setup, case, exc, prepare_fn, factor)
             factor = c.factor
             made.append(c)
             if isinstance(rule, Replay):
                 rule = dataclasses.replace(rule, done=rule.done + 1)
+        except DomainError as exc:
+            if not widen or widenings >= MAX_REGRIDS:
+                raise
+            base = last.state
+            r = widened(setup.grid, exc.axis, setup.band, int(base["n"]) if base else 0,
+                        f"the contact reached the {exc.axis} edge at cycle {exc.cycle}")
+            if exc.axis == "x":
+                wider = along_x(case, setup.grid, r.new_elements[0], r.new_domain[0])
+            else:
+                wider = case.with_choices(domain=r.new_domain, elements=r.new_elements)
+            new_setup, case, _ = prepare_fn(wider)
+            setup = dataclasses.replace(new_setup, per_cycle=setup.per_cycle)
+            state = pad_state(base, r) if base else None
+            widenings += 1
 
 
 def scaled(r: Regrid, factor: int) -> Regrid:

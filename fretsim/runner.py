@@ -226,6 +226,7 @@ class _Sink:
         self.coarsenings: list = list(previous.coarsenings) if previous is not None else []  # ... its coarsenings
         # the output grid (the finest the run used: the results' /grid), and the run's own case on its grid
         self.out_grid, self.run_filled = setup.grid, filled
+        self.first_filled = filled  # the case on the grid the run started on (its companions start there too)
         self.rule = regrid.rule_for(filled, setup, plan)  # when the grid may coarsen (None: never)
 
     @property
@@ -508,7 +509,8 @@ def _estimate_errors(setup, filled, plan, counter, sink: _Sink, t0, runs: SideRu
     file: the estimates are then unknown, and it says why."""
     started = time.perf_counter()
     try:
-        counter.extra = _error_estimates(setup, filled, plan, counter, runs, tuple(sink.coarsenings))
+        counter.extra = _error_estimates(setup, filled, plan, counter, runs, tuple(sink.coarsenings),
+                                         sink.first_filled)
     except KeyboardInterrupt:
         sink.finish_interrupted(counter, t0, lambda: "interrupted while estimating the grid's error (the run itself "
                                 f"is complete); resume with `fretsim run --resume {sink.output}`")
@@ -570,29 +572,31 @@ def _summary(setup, counter, t0) -> dict:
 
 
 def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter", runs: SideRuns,
-                     coarsenings: tuple = ()) -> dict:
+                     coarsenings: tuple = (), first: Optional[Case] = None) -> dict:
     """The total error estimates of the reported numbers: the stepping's, the grid's (from a companion run on a
-    grid twice as coarse, see :mod:`fretsim.grid_error`, which coarsens where the run did: ``coarsenings``) and
-    the model difference ``auto`` accepted."""
+    grid twice as coarse, see :mod:`fretsim.grid_error`, which coarsens where the run did: ``coarsenings``, and
+    starts on the domain the run started on, ``first``'s, widening as the run did where its contact reaches the
+    edge) and the model difference ``auto`` accepted."""
     summary = summarize(setup, counter.last, counter.solves, 0.0, counter.errors)
     model_part = sum(c.error for c in plan.choices)
     if not _estimated(filled):
         return {**grid_error.totals(summary, None, model_part), grid_error.LIMIT_KEY: float("nan")}
-    companion, coarsest_case = _companions(setup, filled)
+    companion, coarsest_case = _companions(setup, first if first is not None else filled)
     replay = tuple(c.cycle for c in coarsenings)
+    widen = regrid.grid_is_automatic(plan)  # the companions' grids follow their contact as the run's did
     try:
         c_setup, c_filled, _ = prepare(companion, runs=runs)
         last, c_setup = _side_run(runs, f"grid error: the case again on a grid twice as coarse "
                                         f"({c_setup.grid.shape[1]} × {c_setup.grid.shape[0]} elements"
                                         f"{', coarsened where the run was' if replay else ''}) to estimate the grid's "
-                                        f"part of the error", c_setup, c_filled, replay)
+                                        f"part of the error", c_setup, c_filled, replay, widen)
     except (SimulationError, CaseError) as exc:  # e.g. the mid-stroke gap, stable on the run's grid, is not on
         #                                           the coarser one: the run stands, its grid error is unknown
         counter.notes.append(f"the grid's error was not estimated: its companion run on a grid twice as coarse "
                              f"stopped ({str(exc)[:160]})")
         return {**grid_error.totals(summary, None, model_part), grid_error.LIMIT_KEY: float("nan")}
     coarse = summarize(c_setup, last, 0, 0.0)
-    coarsest = _coarsest(coarsest_case, runs, replay)
+    coarsest = _coarsest(coarsest_case, runs, replay, widen)
     part = grid_error.grid_estimates(summary, coarse, counter.last.pressure, setup.grid, last.pressure,
                                      c_setup.grid, coarsest)
     out = grid_error.totals(summary, part, model_part)
@@ -649,7 +653,7 @@ def _companions(setup: Setup, filled: Case) -> tuple[Case, Case]:
     return tuple(grid_error.companion_case(filled, line_contact, times=times) for times in (1, 2))
 
 
-def _coarsest(case: Case, runs: SideRuns, replay: tuple = ()) -> Optional[dict]:
+def _coarsest(case: Case, runs: SideRuns, replay: tuple = (), widen: bool = False) -> Optional[dict]:
     """The summary of the run on a grid four times as coarse (whether the peak pressure converges), or None where
     that grid cannot carry the run (too few elements for the contact, an unstable gap): the peak is then read
     from two grids."""
@@ -658,19 +662,21 @@ def _coarsest(case: Case, runs: SideRuns, replay: tuple = ()) -> Optional[dict]:
         last, c_setup = _side_run(runs, f"grid error: the case again on a grid four times as coarse "
                                         f"({c_setup.grid.shape[1]} × {c_setup.grid.shape[0]} elements"
                                         f"{', coarsened where the run was' if replay else ''}) to see whether the "
-                                        f"peak pressure converges", c_setup, c_filled, replay)
+                                        f"peak pressure converges", c_setup, c_filled, replay, widen)
         return summarize(c_setup, last, 0, 0.0)
     except (SimulationError, CaseError):
         return None
 
 
-def _side_run(runs: SideRuns, what: str, setup: Setup, filled: Case, replay: tuple) -> tuple[Step, Setup]:
+def _side_run(runs: SideRuns, what: str, setup: Setup, filled: Case, replay: tuple,
+              widen: bool = False) -> tuple[Step, Setup]:
     """A companion run and the setup it ended on: coarsened at the first step at or past each of the ``replay``
-    cycles, where the run coarsened (so that its estimate covers the grids the run used)."""
-    if not replay:
+    cycles, where the run coarsened (so that its estimate covers the grids the run used), and widened where its
+    contact reaches the edge of its automatic grid, as the run's."""
+    if not replay and not widen:
         return runs.run(what, setup), setup
     last, setup, _ = runs.run_following(what, setup, filled, regrid.Replay(replay),
-                                        functools.partial(prepare, runs=runs))
+                                        functools.partial(prepare, runs=runs), widen=widen)
     return last, setup
 
 

@@ -36,6 +36,7 @@ PRESSURE_SHARE = 30.0
 MAX_PRESSURE_REFINEMENT = (16.0, 4.0)  # per axis over the paper's rule: along x; along y for a point contact
 LINE_ROWS = 27  # paper section 2.1.1: 370 µm across a 10 mm cylinder
 SCAR_MARGIN = 1.3
+COARSEN = 3  # elements an automatic grid that follows the contact merges into one (fretsim.regrid)
 
 
 @dataclass(frozen=True)
@@ -48,6 +49,7 @@ class Sizing:
     note: str
     rule: str = "the paper's convergence rule, dx = 7a/40"  # which rule sized the element along x, and why ("": the
     #                                                          partial-slip refinement, said by the plan)
+    follows: bool = False  # the domain holds the scar of the first coarsening, not the final one: it widens
 
 
 def _odd(n: float) -> int:
@@ -55,16 +57,38 @@ def _odd(n: float) -> int:
     return n if n % 2 else n + 1
 
 
+def _across(geometry: Geometry, h, wide, scar_y: float, refine_y: float) -> tuple[int, float]:
+    """The elements and extent (mm) along y of a 3D grid: a line contact's rows over its length, a point contact's
+    7b/40 (refined ``refine_y``-fold) over its scar with the margin."""
+    if h.line:
+        return LINE_ROWS, geometry.line_length
+    scar_y = min(scar_y, 2 * (geometry.limits.reach_y or scar_y))
+    dy = 7 * h.half_width_y / ELEMENTS_OVER_7A / refine_y
+    ny = _odd(2 * (SCAR_MARGIN * max(scar_y, wide.half_width_y) + 3 * dy) / dy)
+    return ny, ny * dy
+
+
+def _held(scar_x: float, dx: float, accuracy: Optional[float]) -> float:
+    """The scar half-width (mm) the domain holds: the final scar's, or, for a grid that follows the contact (its
+    ``accuracy`` given: a 2D or line-contact grid sized by the accuracy rule, which coarsens COARSEN-fold as the
+    scar allows and widens where the contact reaches its edge, :mod:`fretsim.regrid`), the smaller one at which
+    the accuracy rule first allows elements COARSEN times as long.  A tube's 6 µm Hertz contact wears a scar
+    millimetres wide over 10⁹ cycles: elements of the first micrometres over the final scar's extent made the
+    early cycles cost as much as the rest of the run."""
+    return min(scar_x, 0.5 * COARSEN * dx * WIDTH_SHARE / accuracy) if accuracy else scar_x
+
+
 def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float, cycles: int, k_total: float,
               e_star: float, strokes: int = 1, refine: float = 1.0, accuracy: Optional[float] = None,
               pressure_accuracy: Optional[float] = None, volume: Optional[float] = None,
-              reach_load: Optional[float] = None) -> Sizing:
+              reach_load: Optional[float] = None, grows: bool = False) -> Sizing:
     """The paper's element size and a domain holding the estimated final scar (both bodies' volume), plus
     ``strokes`` stroke amplitudes along x (the flat's wear reaches one stroke beyond the contact; seen through
     the stroke average, two).  Given ``accuracy``, the element along x is also at most accuracy/WIDTH_SHARE of
     the estimated scar width (at most MAX_ACCURACY_REFINEMENT times finer than the paper's).  ``load`` sets the
     element (a load history's lightest contact, the narrowest to resolve); ``reach_load`` (default ``load``) the
-    domain (its heaviest, the widest to hold: a short history wears too little for the scar to outgrow it)."""
+    domain (its heaviest, the widest to hold: a short history wears too little for the scar to outgrow it);
+    ``grows``: the grid will follow the contact (:func:`_held`)."""
     h = geometry.hertz(load, e_star)
     a = h.half_width_x
     wide = geometry.hertz(reach_load, e_star) if reach_load is not None and reach_load > load else h
@@ -116,18 +140,17 @@ def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float
                       + (f" (capped at {cap_y:g})" if refine_y == cap_y else "")))
     if refine != 1.0 and why and refine_y == refine:
         why += f"; along y the paper's rule refined ÷ {refine:.3g} for partial slip"
-    reach = SCAR_MARGIN * max(scar_x, wide.half_width_x) + strokes * stroke + 3 * dx
+    grows = grows and (plane_strain or h.line)  # a point contact's scar grows along y too: it does not coarsen
+    held = _held(scar_x, dx, accuracy if grows and cycles > 0 else None)
+    reach = SCAR_MARGIN * max(held, wide.half_width_x) + strokes * stroke + 3 * dx
     nx = _odd(2 * reach / dx)
-    note = (f"dx = {rule} = {dx * 1e3:.3g} µm (a = {a * 1e3:.3g} µm), x extent {nx * dx:.3g} mm for an estimated "
-            f"scar half-width {scar_x:.3g} mm")
+    note = f"dx = {rule} = {dx * 1e3:.3g} µm (a = {a * 1e3:.3g} µm), x extent {nx * dx:.3g} mm for " + (
+        f"an estimated scar half-width {scar_x:.3g} mm" if held == scar_x else
+        f"the scar half-width {held:.3g} mm at which the grid may first coarsen {COARSEN}-fold (the estimated "
+        f"final scar's is {scar_x:.3g} mm: the grid widens as the scar grows)")
+    follows = held < scar_x
     if plane_strain:
-        return Sizing(a, h.half_width_y, scar_x, (nx * dx,), (nx,), note, why)
-    if h.line:
-        ny, ly = LINE_ROWS, geometry.line_length
-    else:
-        scar_y = min(scar_y, 2 * (limits.reach_y or scar_y))
-        dy = 7 * h.half_width_y / ELEMENTS_OVER_7A / refine_y
-        ny = _odd(2 * (SCAR_MARGIN * max(scar_y, wide.half_width_y) + 3 * dy) / dy)
-        ly = ny * dy
+        return Sizing(a, h.half_width_y, scar_x, (nx * dx,), (nx,), note, why, follows)
+    ny, ly = _across(geometry, h, wide, scar_y, refine_y)
     return Sizing(a, h.half_width_y, scar_x, (nx * dx, ly), (nx, ny),
-                  note + f"; dy = {ly / ny * 1e3:.3g} µm, y extent {ly:.3g} mm", why)
+                  note + f"; dy = {ly / ny * 1e3:.3g} µm, y extent {ly:.3g} mm", why, follows)

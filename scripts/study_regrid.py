@@ -11,11 +11,13 @@ cycles on fewer elements).
 Prints a table; writes scripts/out/regrid.txt.
 
 Coarsening (issue 32, second part): the tubes in service to their wall limit, each run whole (the pilot, the run,
-its grid-error companions, the results file) with the grid coarsened as the scar grows and with coarsening off
-(``fretsim.regrid.rule_for`` returning None everywhere: the previous tree's computation, which
-scripts/compare_trees.py shows bit for bit equal on every case that does not coarsen), alternately, five times
-each (the 3D tube once: its fine run takes over a minute); medians and their ratio, and whether the cycles and years to the limit, the wall loss and the scar width of
-each lie within the other's estimated error.
+its grid-error companions, the results file) three ways, in turn, five times each (the 3D tube once: its fine run
+takes over a minute): ``fine``, one grid sized for the final scar (coarsening off: ``fretsim.regrid.rule_for``
+returning None, the automatic grid sized as before 2026-11-28: the computation before issue 32's coarsening);
+``coarsened``, that grid coarsened as the scar grows; ``follows``, this tree's grid that starts on the scar of its
+first coarsening and widens as the scar grows (its pilot and companions too).  Medians and their ratios, and
+whether the cycles and years to the limit, the wall loss and the scar width of each lie within the fine run's
+estimated error.
 
     python scripts/study_regrid.py --coarsen      # writes scripts/results/regrid_coarsen.txt
 """
@@ -47,50 +49,64 @@ COMPARED = (("cycles_to_limit", "estimated_error_cycles_to_limit", "cycles to li
             ("scar_width_stationary_mm", "estimated_error_width", "flat's scar mm"))
 
 
+SIDES = ("fine", "coarsened", "follows")  # the previous trees' computations, then this one's
+
+
+def _side(side: str, regrid, real_rule, real_grid) -> None:
+    """fine: one grid sized for the final scar (coarsening off, as before issue 32's coarsening); coarsened: that
+    grid coarsened as the scar grows (before 2026-11-28); follows: the grid that starts on the scar of its first
+    coarsening and widens as the scar grows, its pilot and companions too (this tree)."""
+    regrid.rule_for = (lambda *a, **k: None) if side == "fine" else real_rule
+    plan_grid.auto_grid = real_grid if side == "follows" else (lambda *a, **kw: real_grid(*a, **{**kw, "grows": False}))
+
+
 def coarsen() -> None:
     import statistics
     import tempfile
     import fretsim.regrid as regrid
     say = Report()
-    real = regrid.rule_for
+    real_rule, real_grid = regrid.rule_for, plan_grid.auto_grid
     say(f"{'case':<21}{'side':<11}{'whole s':>9}{'loop s':>8}{'comp s':>8}{'solves':>8}{'final grid':>12}"
         f"{'cycles to limit':>18}{'years':>8}{'wall loss µm':>14}{'scar mm':>9}")
     for name, sets, repeats in COARSEN_CASES:
         case = load_case(ROOT / "cases" / f"{name}.yaml", sets)
         name = " ".join([name] + [s.split("=")[1].upper() for s in sets])
-        times: dict = {"coarsened": [], "fine": []}
+        times: dict = {side: [] for side in SIDES}
         outs: dict = {}
         with tempfile.TemporaryDirectory() as tmp:
-            for i in range(repeats + 1):  # the first pair untimed: the caches' warm-up
-                for side in ("coarsened", "fine"):
-                    regrid.rule_for = real if side == "coarsened" else (lambda *a, **k: None)
+            for i in range(repeats + 1):  # the first round untimed: the caches' warm-up
+                for side in SIDES:
+                    _side(side, regrid, real_rule, real_grid)
                     try:
                         t = time.perf_counter()
                         outs[side] = run(case, Path(tmp) / f"{side}.h5", overwrite=True)
                         if i:
                             times[side].append(time.perf_counter() - t)
                     finally:
-                        regrid.rule_for = real
-        for side in ("fine", "coarsened"):
+                        regrid.rule_for, plan_grid.auto_grid = real_rule, real_grid
+        for side in SIDES:
             o, m = outs[side], statistics.median(times[side])
             s = o.summary
             say(f"{name:<21}{side:<11}{m:>9.2f}{s['wall_time_s']:>8.2f}{s['grid_error_wall_time_s']:>8.2f}"
                 f"{s['contact_solves']:>8}{o.setup.grid.shape[1]:>12}{s['cycles_to_limit']:>18,.0f}"
                 f"{s['time_to_limit_h'] / 8766:>8.4f}{s['max_wear_depth_moving_um']:>14.4f}"
                 f"{s['scar_width_stationary_mm']:>9.4f}")
-        ratio = statistics.median(times["fine"]) / statistics.median(times["coarsened"])
-        say(f"    whole run {ratio:.2f}× faster coarsened (medians of {repeats}, alternating); "
-            f"loop {outs['fine'].summary['wall_time_s'] / outs['coarsened'].summary['wall_time_s']:.2f}×, "
-            f"companions {outs['fine'].summary['grid_error_wall_time_s'] / outs['coarsened'].summary['grid_error_wall_time_s']:.2f}×")
+        for faster in ("coarsened", "follows"):
+            ratio = statistics.median(times["fine"]) / statistics.median(times[faster])
+            say(f"    whole run {ratio:.2f}× faster {faster} than fine (medians of {repeats}, in turn); "
+                f"loop {outs['fine'].summary['wall_time_s'] / outs[faster].summary['wall_time_s']:.2f}×, "
+                f"companions {outs['fine'].summary['grid_error_wall_time_s'] / outs[faster].summary['grid_error_wall_time_s']:.2f}×")
         for key, err, label in COMPARED:
-            a, b = outs["coarsened"].summary[key], outs["fine"].summary[key]
-            ea, eb = outs["coarsened"].summary[err], outs["fine"].summary[err]
-            d = abs(a - b) / abs(b)
-            say(f"    {label:<16} differ by {d:.1e}; estimates {ea:.1e} coarsened, {eb:.1e} fine: "
-                f"{'within' if d <= max(ea, eb) else 'NOT within'} each other's")
-        for n in outs["coarsened"].notes:
-            if "coarsened at" in n:
-                say(f"    {n}")
+            b = outs["fine"].summary[key]
+            eb = outs["fine"].summary[err]
+            for side in ("coarsened", "follows"):
+                a, ea = outs[side].summary[key], outs[side].summary[err]
+                d = abs(a - b) / abs(b)
+                say(f"    {label:<16} {side} differs from fine by {d:.1e}; estimates {ea:.1e} {side}, {eb:.1e} fine: "
+                    f"{'within' if d <= max(ea, eb) else 'NOT within'} each other's")
+        for n in outs["follows"].notes:
+            if "coarsened at" in n or "widened along" in n:
+                say(f"    {n[:200]}")
     (ROOT / "scripts" / "results").mkdir(parents=True, exist_ok=True)
     say.write(ROOT / "scripts" / "results" / "regrid_coarsen.txt")
 

@@ -80,11 +80,16 @@ def _sizing(case: Case, contact: Contact, plane: bool, sized: int, refine: float
     accuracy = case.accuracy if case.grid_rule == "accuracy" else None
     k_total = contact.k_moving + contact.k_stationary
     volume = k_total * loading.worn_work(sized)
+    # the grid will follow the contact (fretsim.regrid.rule_for's conditions, known before the grid is): it may then
+    # start on the domain of the scar at which it first coarsens, and widen as the scar grows
+    grows = (accuracy is not None and case.domain is None and case.elements is None and refine == 1.0
+             and case.coarse_element is None and case.moving.fatigue is None and case.stationary.fatigue is None)
 
     def sizing(strokes: int = 1) -> Sizing:
         return auto_grid(case.geometry, plane, loading.lightest_load, loading.peak_stroke, loading.cycles, k_total,
                          contact.e_star, strokes=strokes, refine=refine, accuracy=accuracy,
-                         pressure_accuracy=case.pressure_accuracy, volume=volume, reach_load=loading.peak_load)
+                         pressure_accuracy=case.pressure_accuracy, volume=volume, reach_load=loading.peak_load,
+                         grows=grows)
 
     first = sizing()
     probe = choose_gap_model(case, Grid.centred(3, 1, first.domain[0] / first.elements[0], 1.0, True))
@@ -103,7 +108,9 @@ def choose_grid(case: Case, plane: bool, sizing: Sizing) -> tuple[Choice, Choice
                 f"and slip annulus span {PARTIAL_SLIP_ELEMENTS} elements each (up to {TRANSITION_BAND:g} δ_t, where "
                 f"a worn contact may come to stick, {2 * PARTIAL_SLIP_ELEMENTS} across the half-width; at most "
                 f"{MAX_PARTIAL_SLIP_REFINEMENT:g}× per axis)")
-        return (Choice("grid.domain", sizing.domain, "automatic: holds the estimated final scar: " + sizing.note),
+        return (Choice("grid.domain", sizing.domain, ("automatic: holds the scar of its first coarsening and widens as "
+                                                      "the scar grows: " if sizing.follows else
+                                                      "automatic: holds the estimated final scar: ") + sizing.note),
                 Choice("grid.elements", sizing.elements, "automatic: " + rule))
     if given_d:
         dx = sizing.domain[0] / sizing.elements[0]

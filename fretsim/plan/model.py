@@ -349,9 +349,13 @@ def pilot_cycles(case: Case, runs: SideRuns, plan_case: PlanCase) -> Optional[fl
     """Where a run with wear limits will stop, roughly: the case on the paper's grid, in 2D where the geometry
     has it, at a loose stepping tolerance, no companion (inf if no limit is reached, None if the pilot fails).
     It sizes the grid and places the automatic recorded states."""
+    # the paper's element (the accuracy rule at PILOT_ACCURACY asks no finer where the scar is wide enough to matter),
+    # on a grid that follows the contact: it starts on the scar of its first coarsening and widens as it grows
+    accuracy = max(case.accuracy, PILOT_ACCURACY)
     pilot = case.with_choices(dimension="2d" if case.geometry.has_2d else "3d", corrections="none",
-                              grid_rule="paper", grid_error="none", step_tolerance=max(case.step_tolerance, 0.03),
-                              pressure_accuracy=None, snapshots=(0,), scheme="bdf2")
+                              grid_rule="accuracy", accuracy=accuracy, grid_error="none",
+                              step_tolerance=max(case.step_tolerance, 0.03), pressure_accuracy=None, snapshots=(0,),
+                              scheme="bdf2")
 
     def compute() -> Optional[float]:
         try:
@@ -359,12 +363,12 @@ def pilot_cycles(case: Case, runs: SideRuns, plan_case: PlanCase) -> Optional[fl
             what = "wear limits: a pilot run on the paper's grid to find roughly where the limit is reached"
             # coarsened as its contact grows (fretsim.regrid): a tube's 6 µm Hertz contact grows to a scar
             # millimetres wide
-            rule = regrid.rule_for(filled, setup, plan, accuracy=max(case.accuracy, PILOT_ACCURACY))
+            rule = regrid.rule_for(filled, setup, plan)
             if rule is None:
                 last = runs.run(what, setup)
             else:
                 last, _, _ = runs.run_following(what, setup, filled, rule,
-                                                lambda c: plan_case(c, pilot=float("nan")))
+                                                lambda c: plan_case(c, pilot=float("nan")), widen=True)
             return float(last.limit[1]) if last.limit else math.inf
         except (SimulationError, CaseError):
             return None

@@ -38,14 +38,14 @@ class SideRuns:
         with self._progress(setup) as update:
             return simulate(setup, progress=update)
 
-    def run_following(self, what: str, setup, case, rule, prepare_fn):
-        """:meth:`run` carried through the grid's coarsenings (:func:`fretsim.regrid.following`): (last step, the
-        setup it ended on, the coarsenings)."""
+    def run_following(self, what: str, setup, case, rule, prepare_fn, widen: bool = False):
+        """:meth:`run` carried through the grid's coarsenings and, ``widen``, its widenings
+        (:func:`fretsim.regrid.following`): (last step, the setup it ended on, the coarsenings)."""
         from fretsim.regrid import following
         self.say(what)
         with self._progress(setup) as update:
-            return following(lambda s, st, r: simulate(s, progress=update, resume=st, coarsen=r), setup, case,
-                             rule, prepare_fn)
+            return following(lambda s, st, r, obs: simulate(s, obs, progress=update, resume=st, coarsen=r), setup,
+                             case, rule, prepare_fn, widen)
 
     def _progress(self, setup):
         """The owner's progress for ``setup`` (a context manager yielding a callback), or none."""
