@@ -22,10 +22,10 @@ ELEMENTS_OVER_7A = 40  # paper Table 1
 # The reported scar widths are where the depth crosses 0.1 % of its peak, read between element centres
 # (fretsim.measures.scar_width) to within an element: at most 0.28-0.49 element widths of error at the accuracy
 # grid and the two grids below it, 0.95 on grids 8× coarser (scripts/study_width_error.py).  The width's estimate
-# (fretsim.grid_error) is the stepping's part plus the larger of one element over the width and the companion's
-# difference, so a width within model.accuracy needs an element of at most accuracy/WIDTH_SHARE of the scar: a
-# third of the accuracy for the element, the rest for the stepping and a companion twice as coarse (measured:
-# estimates 0.59-0.75 % at accuracy 1 %; with a share of 2.1, 1 of 32 widths over).
+# (fretsim.grid_error) is the stepping's part plus one element over the width plus the companion's difference,
+# so a width within model.accuracy needs an element of at most accuracy/WIDTH_SHARE of the scar: a third of the
+# accuracy for the element, the rest for the stepping and a companion twice as coarse (measured: estimates 0.68 %
+# in the median at accuracy 1 %, 3 of 32 over it).
 WIDTH_SHARE = 3.0
 MAX_ACCURACY_REFINEMENT = 4.0  # per axis, over the paper's rule: beyond it the cost grows faster than it pays
 # The pressure field's L2 error, as the companion grid estimates it, falls about as the element along x over the
@@ -140,7 +140,8 @@ def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float
                       + (f" (capped at {cap_y:g})" if refine_y == cap_y else "")))
     if refine != 1.0 and why and refine_y == refine:
         why += f"; along y the paper's rule refined ÷ {refine:.3g} for partial slip"
-    grows = grows and (plane_strain or h.line)  # a point contact's scar grows along y too: it does not coarsen
+    # (as fretsim.regrid.rule_for: a point contact's scar grows along y too, and it does not coarsen)
+    grows = grows and (plane_strain or geometry.y_edges_free)
     held = _held(scar_x, dx, accuracy if grows and cycles > 0 else None)
     reach = SCAR_MARGIN * max(held, wide.half_width_x) + strokes * stroke + 3 * dx
     nx = _odd(2 * reach / dx)

@@ -207,3 +207,20 @@ def test_a_pressure_accuracy_beyond_the_grids_cap_is_said_not_met():
     assert out.summary["estimated_error_pressure"] > 0.01
     assert any("exceeds model.pressure_accuracy" in n for n in out.notes)
     assert any("capped at 16" in n for n in out.notes)
+
+
+@pytest.mark.xfail(strict=True, reason="known gap (docs/verification.md, The scar width between element centres): "
+                   "on the paper's grid, a partial-slip scar reads 1.5 elements wide on the run's grid and on its "
+                   "companion's alike, so their difference does not see it")
+def test_a_partial_slip_scars_width_on_the_papers_grid_is_covered_by_its_estimate():
+    """Ti-6Al-4V cylinder on flat in partial slip, 100 cycles, 3 µm stroke, the paper's grid (refined 7a/40 ÷ 3 for
+    the stick zone; no warning): the width is 5.7 % off against 16× the elements, estimated 3.85 %."""
+    name = "ti_fretting_fatigue"
+    sets = ["loading.cycles=100", "loading.stroke=3 um"]
+    out = run(load_case(CASES / f"{name}.yaml", sets + ["grid.rule=paper"]))
+    assert out.summary["stick_half_width_x_mm"] > 0  # partial slip
+    f = out.case
+    ref = run(load_case(CASES / f"{name}.yaml", sets + [
+        "grid.error_estimate=none", f"grid.domain=[{f.domain[0]!r} mm]", f"grid.elements=[{int(f.elements[0] * 16) | 1}]"]))
+    width = max(abs(out.summary[k] / ref.summary[k] - 1) for k in WIDTHS)
+    assert width <= out.summary["estimated_error_width"], (width, out.summary["estimated_error_width"])
