@@ -198,6 +198,11 @@ def resume(output: str | Path, *, progress: Optional[Callable[[int], None]] = No
             raise CaseError(str(output), [("", f"/checkpoint: the cycle {str(n)[:20]} does not fit the case's "
                                                f"{setup.cycles} cycles")], "results file")
         sink = _Sink(output, setup, filled, plan, True, previous)
+        if previous.regrids:  # the grid the run started on (its companions start there): before its first change
+            first = previous.regrids[0]
+            plane = setup.grid.plane_strain
+            sink.first_filled = filled.with_choices(domain=first.old_domain[:1] if plane else first.old_domain,
+                                                    elements=first.old_elements[:1] if plane else first.old_elements)
         if previous.coarsenings:  # on the grid the run had coarsened to, from its checkpoint's coarse elements
             factor = sink.factor
             g = setup.grid

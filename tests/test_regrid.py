@@ -485,3 +485,20 @@ def test_a_side_run_widens_its_automatic_grid_from_its_last_step_and_a_users_gri
         SideRuns().run_following("", setup, filled, rule, prepare, widen=False)
     last, end, made = SideRuns().run_following("", setup, filled, rule, prepare, widen=True)
     assert last.limit is not None and end.grid.shape[1] * end.grid.dx > 2 * setup.grid.shape[1] * setup.grid.dx
+
+
+def test_a_run_interrupted_after_its_grid_widened_resumes_to_the_same_error_estimates(tmp_path):
+    """The companions start on the domain the run started on; a resumed run plans from its file's (widened) grid,
+    and read its first domain back from /regrids: its estimates are the uninterrupted run's, bit for bit."""
+    from conftest import interrupted_and_resumed
+    sets = ["limits.wall_loss=20 %"]
+    whole = run(load_case(TUBE, sets), tmp_path / "whole.h5")
+    a = read_results(tmp_path / "whole.h5")
+    widened = [r for r in a.regrids if not r.reason.startswith("padded")]
+    assert len(widened) >= 2, a.regrids
+    resumed = interrupted_and_resumed(TUBE, sets, widened[1].cycle + 1, tmp_path / "cut.h5")
+    assert resumed.status == whole.status
+    b = read_results(tmp_path / "cut.h5")
+    for key in ("estimated_error_depth", "estimated_error_width", "estimated_error_pressure",
+                "estimated_error_max_pressure", "estimated_error_cycles_to_limit", "cycles_to_limit"):
+        assert b.summary[key] == a.summary[key], key
