@@ -48,9 +48,7 @@ import numpy as np
 from fretsim.errors import DomainError
 from fretsim.grid import Grid
 from fretsim.sizing import COARSEN  # elements merged into one: odd, so a centred odd grid stays centred and nested
-MAX_REGRIDS = 12  # each at least 1.6× the extent: 280× the planned extent in all, beyond which the plan was wrong
-#                  (a grid that follows the contact plans to widen: a tube's pilot 7 times, from the 0.1 mm scar of
-#                  its first coarsening to the 6 mm of its limit)
+MAX_REGRIDS = 6  # beyond the planned extent, each at least 1.6× it: 17× in all, beyond which the plan was wrong
 GROWTH = 0.3  # each side gains at least this share of the extent (and the stroke's reach): a few regrids at most
 
 
@@ -75,6 +73,14 @@ def widenings(regrids) -> int:
     """The widenings among ``regrids`` (/regrids rows): not the paddings a coarsening makes, a few elements each,
     which MAX_REGRIDS does not count."""
     return sum(not r.reason.startswith("padded") for r in regrids)
+
+
+def allowed(extent: float, planned: float) -> int:
+    """The widenings a grid starting ``extent`` mm wide along x may make: those a grid that follows the contact
+    plans, to reach the ``planned`` extent of the final scar (each adds at least GROWTH of the extent on both
+    sides), and MAX_REGRIDS more for a scar that outgrows the plan."""
+    planned_ones = math.ceil(math.log(planned / extent) / math.log(1 + 2 * GROWTH)) if planned > extent > 0 else 0
+    return MAX_REGRIDS + planned_ones
 
 
 def grid_is_automatic(plan) -> bool:
@@ -367,9 +373,9 @@ class _Last:
 def following(run: Callable, setup, case, rule: Callable, prepare_fn: Callable, widen: bool = False):
     """``run(setup, resume, coarsen, observers)`` (a side run: a pilot, a companion) carried through its
     coarsenings, and, ``widen``, through the widenings of its automatic grid where the contact reaches its edge
-    (from its last accepted step, as the run's own: :mod:`fretsim.runner`), at most MAX_REGRIDS of them: its last
-    step, the setup it ended on and the coarsenings made."""
-    state, made, factor, widenings = None, [], 1, 0
+    (from its last accepted step, as the run's own: :mod:`fretsim.runner`), at most :func:`allowed` of them: its
+    last step, the setup it ended on and the coarsenings made."""
+    state, made, factor, widenings, start = None, [], 1, 0, setup
     while True:
         last = _Last(state)
         try:
@@ -381,7 +387,7 @@ def following(run: Callable, setup, case, rule: Callable, prepare_fn: Callable, 
             if isinstance(rule, Replay):
                 rule = dataclasses.replace(rule, done=rule.done + 1)
         except DomainError as exc:
-            if not widen or widenings >= MAX_REGRIDS:
+            if not widen or widenings >= allowed(start.grid.shape[1] * start.grid.dx, start.planned_extent):
                 raise
             base = last.state
             r = widened(setup.grid, exc.axis, setup.band, int(base["n"]) if base else 0,

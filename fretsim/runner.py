@@ -203,6 +203,7 @@ def resume(output: str | Path, *, progress: Optional[Callable[[int], None]] = No
             plane = setup.grid.plane_strain
             sink.first_filled = filled.with_choices(domain=first.old_domain[:1] if plane else first.old_domain,
                                                     elements=first.old_elements[:1] if plane else first.old_elements)
+            sink.allowed = regrid.allowed(first.old_domain[0], setup.planned_extent)
         if previous.coarsenings:  # on the grid the run had coarsened to, from its checkpoint's coarse elements
             factor = sink.factor
             g = setup.grid
@@ -232,6 +233,7 @@ class _Sink:
         # the output grid (the finest the run used: the results' /grid), and the run's own case on its grid
         self.out_grid, self.run_filled = setup.grid, filled
         self.first_filled = filled  # the case on the grid the run started on (its companions start there too)
+        self.allowed = regrid.allowed(setup.grid.shape[1] * setup.grid.dx, setup.planned_extent)  # widenings
         self.rule = regrid.rule_for(filled, setup, plan)  # when the grid may coarsen (None: never)
 
     @property
@@ -441,8 +443,8 @@ def _widen(exc: DomainError, counter, sink: _Sink, runs: SideRuns, resumed: Opti
     base = counter.last.state if counter.last is not None else resumed
     if not regrid.grid_is_automatic(plan):
         return None, ""
-    if regrid.widenings(sink.regrids) >= regrid.MAX_REGRIDS:
-        times = f"{regrid.MAX_REGRIDS} time{'s' if regrid.MAX_REGRIDS != 1 else ''}"
+    if regrid.widenings(sink.regrids) >= sink.allowed:
+        times = f"{sink.allowed} time{'s' if sink.allowed != 1 else ''}"
         why = (f"the automatic grid was widened {times}, the most allowed: the scar outgrew the planned one far "
                f"beyond its estimate")
         counter.notes.append(why)

@@ -74,6 +74,8 @@ class Setup:
     gross_slip_stroke: float = float("nan")  # mm: δ_t of the unworn contact (NaN without a friction coefficient)
     regime_block: Optional[object] = None  # the block δ_t is of (the one nearest partial slip)
     notes: tuple[str, ...] = ()
+    planned_extent: float = 0.0  # mm along x: the grid that holds the final scar the plan expects (a grid that
+    #                              follows the contact starts smaller and widens to it: fretsim.regrid.allowed)
     block_cycles: tuple = ()  # a load history: the cycle model of each block of ``loading`` (empty: ``cycle``)
     wear_limits: dict = field(default_factory=dict)  # fretsim.limits: key -> limit (internal units)
     wall: Optional[float] = None  # mm, a tube's wall thickness (the wall_loss limit)

@@ -50,6 +50,7 @@ class Sizing:
     rule: str = "the paper's convergence rule, dx = 7a/40"  # which rule sized the element along x, and why ("": the
     #                                                          partial-slip refinement, said by the plan)
     follows: bool = False  # the domain holds the scar of the first coarsening, not the final one: it widens
+    final_extent: float = 0.0  # mm along x: the extent that holds the final scar (the domain, unless it follows)
 
 
 def _odd(n: float) -> int:
@@ -150,8 +151,9 @@ def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float
         f"the scar half-width {held:.3g} mm at which the grid may first coarsen {COARSEN}-fold (the estimated "
         f"final scar's is {scar_x:.3g} mm: the grid widens as the scar grows)")
     follows = held < scar_x
+    final = _odd(2 * (SCAR_MARGIN * max(scar_x, wide.half_width_x) + strokes * stroke + 3 * dx) / dx) * dx
     if plane_strain:
-        return Sizing(a, h.half_width_y, scar_x, (nx * dx,), (nx,), note, why, follows)
+        return Sizing(a, h.half_width_y, scar_x, (nx * dx,), (nx,), note, why, follows, final)
     ny, ly = _across(geometry, h, wide, scar_y, refine_y)
     return Sizing(a, h.half_width_y, scar_x, (nx * dx, ly), (nx, ny),
-                  note + f"; dy = {ly / ny * 1e3:.3g} µm, y extent {ly:.3g} mm", why, follows)
+                  note + f"; dy = {ly / ny * 1e3:.3g} µm, y extent {ly:.3g} mm", why, follows, final)

@@ -502,3 +502,17 @@ def test_a_run_interrupted_after_its_grid_widened_resumes_to_the_same_error_esti
     for key in ("estimated_error_depth", "estimated_error_width", "estimated_error_pressure",
                 "estimated_error_max_pressure", "estimated_error_cycles_to_limit", "cycles_to_limit"):
         assert b.summary[key] == a.summary[key], key
+
+
+def test_the_widenings_a_grid_that_follows_the_contact_plans_do_not_use_up_the_margin_for_a_wrong_plan(monkeypatch):
+    """MAX_REGRIDS is the margin for a scar that outgrows the plan; a grid that starts small plans its own
+    widenings (up to the final scar's extent), which come on top.  With no margin at all the tube still runs to
+    its limit, pilot included; a grid that does not follow the contact gets the margin alone."""
+    import fretsim.regrid as regrid
+    g = 1 + 2 * regrid.GROWTH
+    assert regrid.allowed(1.0, 1.0) == regrid.allowed(1.0, 0.5) == regrid.MAX_REGRIDS
+    assert regrid.allowed(1.0, g) == regrid.MAX_REGRIDS + 1 and regrid.allowed(1.0, g * 1.01) == regrid.MAX_REGRIDS + 2
+    monkeypatch.setattr(regrid, "MAX_REGRIDS", 0)
+    out = run(load_case(TUBE, TUBE_SETS))
+    assert out.status == "complete" and out.summary["limit_reached"], out.message
+    assert sum("widened along x" in n for n in out.notes) >= 2

@@ -97,7 +97,8 @@ def _setup(case: Case, plan: Plan, grids, operators, regime, cycles, steps, cont
                  coarse_gap=operators.coarse_gap, per_cycle=steps.per_cycle,
                  gross_slip_stroke=regime.transition if regime.transition is not None else float("nan"),
                  regime_block=regime.block if regime.transition is not None else None,
-                 notes=_notes(plan), **_fatigue(case, grids.grid, steps.snapshots, contact))
+                 notes=_notes(plan), planned_extent=grids.sizing.final_extent,
+                 **_fatigue(case, grids.grid, steps.snapshots, contact))
 
 
 HALF_SPACE = 0.1  # the moving body's fatigue: the largest unworn contact half-width a/R its half-space may take

@@ -150,11 +150,11 @@ def choose_snapshots(case: Case, expected: Optional[float] = None) -> Choice:
                       "(the stop itself is recorded)")
     if expected >= n:
         return Choice("output.snapshots", tuple(sorted({0, n // 4, n // 2, 3 * n // 4, n})),
-                      quarters + " (a pilot on the paper's grid reached no wear limit before N)")
+                      quarters + " (a pilot run reached no wear limit before N)")
     stop = round(expected)
     return Choice("output.snapshots", tuple(sorted({0, stop // 4, stop // 2, 3 * stop // 4, n})),
                   f"automatic, for a run with wear limits: 0, S/4, S/2 and 3S/4 on the way to S = {stop:,} cycles, "
-                  f"where a pilot on the paper's grid reached a limit, and N (loading.cycles, the upper bound); the "
+                  f"where a pilot run reached a limit, and N (loading.cycles, the upper bound); the "
                   f"stop itself is recorded when reached")
 
 

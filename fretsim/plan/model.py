@@ -7,7 +7,8 @@ mccoll_500N_10um's 2D proxy differed from 3D by 0.99 %, at full resolution by 1.
 moving body's scar width.  So ``auto`` accepts a simpler model only where PROXY_MARGIN times the proxy's
 difference is within model.accuracy, and reports that product as the model's part of the error estimates.
 
-A run with wear limits is sized for the wear at the limit, which a *pilot* run on the paper's grid finds.
+A run with wear limits is sized for the wear at the limit, which a *pilot* run finds (the paper's element,
+coarsening and widening as its scar grows, a loose tolerance).
 """
 from __future__ import annotations
 
@@ -339,7 +340,7 @@ def cycles_to_size(case: Case, plan: Plan, expected: Optional[float]) -> int:
     if expected is not None and PILOT_MARGIN * expected < loading.cycles:  # reached well before loading.cycles
         sized = max(1, int(PILOT_MARGIN * expected))
         plan.warnings.append(f"wear limits: the grid and auto's proxies take the wear of {sized:,} cycles, "
-                             f"{PILOT_MARGIN:g}× where a pilot on the paper's grid reached a limit "
+                             f"{PILOT_MARGIN:g}× where a pilot run reached a limit "
                              f"({expected:,.0f}); loading.cycles ({loading.cycles:,}) is the upper bound")
         return sized
     return loading.cycles
@@ -360,7 +361,7 @@ def pilot_cycles(case: Case, runs: SideRuns, plan_case: PlanCase) -> Optional[fl
     def compute() -> Optional[float]:
         try:
             setup, filled, plan = plan_case(pilot, pilot=float("nan"))
-            what = "wear limits: a pilot run on the paper's grid to find roughly where the limit is reached"
+            what = "wear limits: a pilot run (the paper's element, a loose tolerance) to find roughly where the limit is reached"
             # coarsened as its contact grows (fretsim.regrid): a tube's 6 µm Hertz contact grows to a scar
             # millimetres wide
             rule = regrid.rule_for(filled, setup, plan)
