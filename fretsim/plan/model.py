@@ -347,9 +347,10 @@ def cycles_to_size(case: Case, plan: Plan, expected: Optional[float]) -> int:
 
 
 def pilot_cycles(case: Case, runs: SideRuns, plan_case: PlanCase) -> Optional[float]:
-    """Where a run with wear limits will stop, roughly: the case on the paper's grid, in 2D where the geometry
-    has it, at a loose stepping tolerance, no companion (inf if no limit is reached, None if the pilot fails).
-    It sizes the grid and places the automatic recorded states."""
+    """Where a run with wear limits will stop, roughly: the case on the paper's element (its grid following the
+    contact where it may coarsen), in 2D where the geometry has it, at a loose stepping tolerance, no companion
+    (inf if no limit is reached, None if the pilot fails).  It sizes the grid and places the automatic recorded
+    states."""
     # the paper's element (the accuracy rule at PILOT_ACCURACY asks no finer where the scar is wide enough to matter),
     # on a grid that follows the contact: it starts on the scar of its first coarsening and widens as it grows
     accuracy = max(case.accuracy, PILOT_ACCURACY)
@@ -361,7 +362,8 @@ def pilot_cycles(case: Case, runs: SideRuns, plan_case: PlanCase) -> Optional[fl
     def compute() -> Optional[float]:
         try:
             setup, filled, plan = plan_case(pilot, pilot=float("nan"))
-            what = "wear limits: a pilot run (the paper's element, a loose tolerance) to find roughly where the limit is reached"
+            what = ("wear limits: a pilot run (the paper's element, a loose tolerance) to find roughly where the "
+                    "limit is reached")
             # coarsened as its contact grows (fretsim.regrid): a tube's 6 µm Hertz contact grows to a scar
             # millimetres wide
             rule = regrid.rule_for(filled, setup, plan)
