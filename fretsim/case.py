@@ -300,6 +300,7 @@ SECTIONS = ("name", "geometry", "materials", "loading", "model", "solver", "jump
 # a wear limit per summary quantity (fretsim.limits): the run stops where the first is reached
 LIMITS_SCHEMA = {key: Key(q.kind, q.long_name, None, **({"lo": 1e-6, "hi": 1.0} if q.kind == "fraction" else {}))
                  for key, q in WEAR.items()}
+MIN_FRICTION = 1e-9  # below it a friction coefficient is 0 in all but name: μ·p underflows the tangential solve
 CRACK_LIMIT = "crack_initiation"  # limits.crack_initiation: true — the fatigue damage's limit, not a wear quantity
 BLOCK_KEYS = ("normal_load", "stroke", "cycles", "friction_coefficient")
 MAX_BLOCKS = 10_000  # blocks after repeats: each restarts the stepping (a few solves)
@@ -1152,6 +1153,10 @@ def _check_model(r: "_Reader", geometry, materials: dict, model: dict, mu: Optio
     elif mu == 0 and why:
         r.fail("loading.friction_coefficient", f"0 with {why}: without friction it has nothing to work with "
                                                f"(no shear traction, no dissipated energy); give μ > 0")
+    if mu is not None and 0 < mu < MIN_FRICTION:
+        r.fail("loading.friction_coefficient", f"{mu:g}: expected 0 (frictionless) or at least {MIN_FRICTION:g}; a "
+                                               f"smaller μ is frictionless in all but name, and its shear tractions "
+                                               f"underflow the tangential solve")
 
 
 def _loading(r: "_Reader", load: dict, blocks: Optional[tuple], repeat: int, spectrum: bool) -> Loading:

@@ -1,4 +1,6 @@
 """The case file: contract layout, units, and clear errors that name the YAML path."""
+from pathlib import Path
+
 import pytest
 
 from fretsim.case import CaseError, load_case, parse_case
@@ -157,3 +159,15 @@ def test_a_plural_subject_takes_have_in_the_problem_count():
     many = [("a", "x"), ("b", "y")]
     assert "the measurements have 2 problems" in str(CaseError("m.csv", many, "measurements"))
     assert "the case has 2 problems" in str(CaseError("c.yaml", many))
+
+
+def test_a_friction_coefficient_too_small_to_carry_a_traction_is_refused_and_zero_is_not():
+    """μ = 1e-300 with model.slip coulomb made `fretsim check` end in a traceback (its shear tractions underflowed
+    the tangential solve; found by the slow friction fuzz): a μ between 0 and MIN_FRICTION is refused, naming the
+    key; μ = 0 (frictionless) and MIN_FRICTION itself are accepted."""
+    from fretsim.case import MIN_FRICTION
+    path = Path(__file__).resolve().parent.parent / "cases" / "mccoll_185N.yaml"
+    with pytest.raises(CaseError, match="loading.friction_coefficient"):
+        load_case(path, ["model.dimension=2d", "loading.friction_coefficient=1e-300", "model.slip=coulomb"])
+    load_case(path, ["model.dimension=2d", "loading.friction_coefficient=0"])
+    load_case(path, ["model.dimension=2d", f"loading.friction_coefficient={MIN_FRICTION}", "model.slip=coulomb"])
