@@ -144,14 +144,16 @@ def auto_grid(geometry: Geometry, plane_strain: bool, load: float, stroke: float
     # (as fretsim.regrid.rule_for: a point contact's scar grows along y too, and it does not coarsen)
     grows = grows and (plane_strain or geometry.y_edges_free)
     held = _held(scar_x, dx, accuracy if grows and cycles > 0 else None)
-    reach = SCAR_MARGIN * max(held, wide.half_width_x) + strokes * stroke + 3 * dx
-    nx = _odd(2 * reach / dx)
+    def elements_holding(half: float) -> int:  # a scar of this half-width, with the margin and the stroke's reach
+        return _odd(2 * (SCAR_MARGIN * max(half, wide.half_width_x) + strokes * stroke + 3 * dx) / dx)
+
+    nx = elements_holding(held)
     note = f"dx = {rule} = {dx * 1e3:.3g} µm (a = {a * 1e3:.3g} µm), x extent {nx * dx:.3g} mm for " + (
         f"an estimated scar half-width {scar_x:.3g} mm" if held == scar_x else
         f"the scar half-width {held:.3g} mm at which the grid may first coarsen {COARSEN}-fold (the estimated "
         f"final scar's is {scar_x:.3g} mm: the grid widens as the scar grows)")
     follows = held < scar_x
-    final = _odd(2 * (SCAR_MARGIN * max(scar_x, wide.half_width_x) + strokes * stroke + 3 * dx) / dx) * dx
+    final = elements_holding(scar_x) * dx
     if plane_strain:
         return Sizing(a, h.half_width_y, scar_x, (nx * dx,), (nx,), note, why, follows, final)
     ny, ly = _across(geometry, h, wide, scar_y, refine_y)

@@ -222,3 +222,14 @@ def underestimate(monkeypatch, factor: float):
 def underestimated(monkeypatch):
     """:func:`underestimate` by 30."""
     return underestimate(monkeypatch, 30)
+
+
+def chord_width(profile, x, fraction=1e-3):
+    """The scar width as fretsim read it before 2026-11-28: each crossing of ``fraction`` of the peak interpolated
+    linearly between the element centres around it (the chord), for the tests that compare the reading with it."""
+    level = fraction * profile.max()
+    above = np.flatnonzero(profile > level)
+    lo, hi = above[0], above[-1]
+    right = x[hi + 1] + (x[hi] - x[hi + 1]) * (level - profile[hi + 1]) / (profile[hi] - profile[hi + 1])
+    left = x[lo - 1] + (x[lo] - x[lo - 1]) * (level - profile[lo - 1]) / (profile[lo] - profile[lo - 1])
+    return right - left

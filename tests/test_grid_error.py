@@ -86,20 +86,11 @@ def test_a_converging_peak_is_read_from_the_nearer_difference_and_a_wandering_on
     assert not ok and est == pytest.approx(SQRT_H * 0.05)
 
 
-def _chord_width(profile, x, fraction=1e-3):
-    """The width as fretsim read it before 2026-11-28: each crossing interpolated linearly between centres."""
-    level = fraction * profile.max()
-    above = np.flatnonzero(profile > level)
-    lo, hi = above[0], above[-1]
-    right = x[hi + 1] + (x[hi] - x[hi + 1]) * (level - profile[hi + 1]) / (profile[hi] - profile[hi + 1])
-    left = x[lo - 1] + (x[lo] - x[lo - 1]) * (level - profile[lo - 1]) / (profile[lo] - profile[lo - 1])
-    return right - left
-
-
 def test_the_papers_grid_reads_its_widths_within_an_element_and_its_estimate_covers_them():
     """McColl 1670 N in 2D at the paper's 7a/40 (dx/W ≈ 1.8 %), against 8× finer: the chord reading of the
     crossing was 1.8 % off, the sub-element reading is within an element (measured 0.68 %) and closer than the
     chord on both bodies; the estimate covers the error and, being over model.accuracy, is said."""
+    from conftest import chord_width as _chord_width
     from fretsim.measures import centre_line
     out = run(load_case(CASES / "mccoll_1670N.yaml", ["model.dimension=2d", "grid.rule=paper"]))
     ref = _finer("mccoll_1670N", out, 8)

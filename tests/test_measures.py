@@ -5,17 +5,10 @@ import math
 import numpy as np
 import pytest
 
+from conftest import chord_width as _chord
 from fretsim.measures import scar_width
 
 X = (np.arange(201) - 100) * 0.01  # mm, element centres 10 µm apart
-
-
-def _chord(profile, x, fraction=1e-3):
-    level = fraction * profile.max()
-    above = np.flatnonzero(profile > level)
-    lo, hi = above[0], above[-1]
-    return (x[hi + 1] + (x[hi] - x[hi + 1]) * (level - profile[hi + 1]) / (profile[hi] - profile[hi + 1])
-            - x[lo - 1] - (x[lo] - x[lo - 1]) * (level - profile[lo - 1]) / (profile[lo] - profile[lo - 1]))
 
 
 @pytest.mark.parametrize("edge", [0.3, 0.3033, 0.3071, 0.3099])
