@@ -497,12 +497,13 @@ def exact_partial_slip():
     return _run(*PARTIAL_2D, "jumping.scheme=linear", "jumping.linear=1")
 
 
-@pytest.mark.parametrize("scheme, tolerance", [("bdf2", 1e-3), ("implicit", 5e-3), ("adaptive", 1e-2)])
+@pytest.mark.parametrize("scheme, tolerance", [("bdf2", 3e-3), ("implicit", 3e-3), ("adaptive", 1e-2)])
 def test_partial_slip_stepping_meets_the_exact_per_cycle_run(exact_partial_slip, scheme, tolerance):
     """The rates of a partly stuck contact are not linear in the pressure and change where the stick edge moves.
-    Measured against the per-cycle run: bdf2 2.6e-4 (the bound 1e-3 is a tenth of its tolerance), backward Euler
-    2.3e-3, the paper's adaptive jumps 4.5e-3 (first order: bounds about twice that), each with an error estimate
-    of its size (measured 0.95e-3, 2.4e-3, 8.5e-3)."""
+    Measured against the per-cycle run: the implicit schemes, which take forward-Euler steps under error control
+    while the cycle has a stick zone (fretsim.stepping.implicit), 1.8e-3 with an estimate of 2.3e-3 (their BDF2
+    steps were 2.6e-4 off over these 3 000 cycles, but 21-35 % off over 10⁵: the next test); the paper's adaptive
+    jumps 4.5e-3 (estimate 8.5e-3).  First order: bounds about 1.5-2× the measured error."""
     out = _run(*PARTIAL_2D, f"jumping.scheme={scheme}")
     assert out.status == "complete", out.message
     s, ref = out.summary, exact_partial_slip.summary
@@ -512,6 +513,25 @@ def test_partial_slip_stepping_meets_the_exact_per_cycle_run(exact_partial_slip,
     assert worst < tolerance
     assert s["error_estimate_depth"] >= 0.5 * worst
     assert s["contact_solves"] < 0.02 * ref["contact_solves"]
+
+
+def test_a_long_partial_slip_run_keeps_to_short_explicit_steps_and_its_estimate_covers_the_difference():
+    """Ti-6Al-4V at 5 µm stroke, 10⁵ cycles (cases/ti_fretting_fatigue.yaml, its fatigue off): BDF2's linearised
+    steps, which corrected the stick zone's wear once, ended 21 % deep (0.710 against 0.586 µm) with a stepping
+    estimate of 1.7 %.  Against the paper's explicit jumps of 50 cycles (within 8.5e-5 of the run cycle by cycle,
+    measured: 0.58574 against 0.58569 µm) the default now stays within 1e-3 (measured 1.7e-4), and its estimate
+    covers the difference (measured 1.8e-3)."""
+    base = ("materials.stationary.fatigue=null", "grid.error_estimate=none")
+    ref = _run(*base, "jumping.scheme=linear", "jumping.linear=50", case="ti_fretting_fatigue.yaml").summary
+    out = _run(*base, case="ti_fretting_fatigue.yaml")
+    s = out.summary
+    assert out.status == "complete", out.message
+    assert s["regime"] == ref["regime"] == "partial_slip"
+    worst = max(abs(s[k] / ref[k] - 1) for k in ("max_wear_depth_stationary_um", "max_wear_depth_moving_um",
+                                                    "centre_wear_depth_stationary_um", "scar_width_stationary_mm"))
+    assert worst < 1e-3
+    assert s["error_estimate_depth"] >= worst
+    assert s["contact_solves"] < 0.6 * ref["contact_solves"]
 
 
 def test_every_cycle_keeps_within_what_the_physics_allows(exact_partial_slip):

@@ -382,7 +382,9 @@ class _Tally:
             regime="partial_slip" if stick_end.any() else "gross_slip",
             stick_half_width_x=stick_half_width(stick_end[g.shape[0] // 2], g.x, g.dx), contact=res_mid,
             iterations=self.iterations, loop=(np.array(self.loop_u), np.array(self.loop_q)),
-            memory={"slip_lin": max(s_max, 1e-300), "slip_spread": 1.0 - s_mean / s_max if s_max > 0 else 1.0},
+            memory={"slip_lin": max(s_max, 1e-300), "slip_spread": 1.0 - s_mean / s_max if s_max > 0 else 1.0,
+                    # a stick zone: the implicit steps take forward-Euler ones (fretsim.stepping.implicit)
+                    "stuck": float(stick_end.any())},
             defect=defect, mismatch=mismatch, stick=stick_end if stick_end.any() else None)
 
 
