@@ -248,7 +248,7 @@ def _partial_slip_step(loop):
     scheme estimates it) stays within the depths' share of the tolerance; kept in the BDF2 history as an exact cycle
     is, so implicit steps resume from it should the stick zone vanish."""
     s = loop.s
-    d = int(max(1, min(loop.jump, s.stability_limit / 2.0, loop.next_stop() - loop.n)))
+    d = int(max(1, min(loop.jump, s.stability_limit / 2.0, s.max_jump or np.inf, loop.next_stop() - loop.n)))
     before = (loop.err_abs_m, loop.err_abs_s)
     cyc, e_p = loop.explicit_step(d)
     local = max(relative_to_deepest(loop.err_abs_m - before[0], loop.h_m),
