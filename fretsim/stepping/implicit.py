@@ -8,8 +8,8 @@ in time, their estimate is meaningless, and their error is the pressure lag's, w
 Pressure: a step leaves a lag of about half the pressure change over it; near a recorded state the steps shrink
 until that lag is within the tolerance.  A solve that fails is retried with a quarter step.
 
-Partial slip (a Coulomb cycle with a stick zone): forward-Euler steps of half the explicit stability limit
-instead (:func:`_partial_slip_step`).  The implicit step solves the contact with the wear every point would have
+Partial slip (a Coulomb cycle with a stick zone): forward-Euler steps under error control instead, of at most
+half the explicit stability limit (:func:`_partial_slip_step`).  The implicit step solves the contact with the wear every point would have
 sliding as far as the furthest (``slip_lin``), then corrects its gap once for the wear the cycle really found; in
 the stick zone, which does not wear, that iteration barely contracts once the step exceeds a few tens of cycles.
 Its residue is invisible to the deepest element's error estimate, yet it moves the stick zone's edge, where the
@@ -217,12 +217,18 @@ def _exact_cycle(loop):
     cycles change the pressure by ~0.5 % each, too fast for the modified equation the implicit schemes
     integrate; taken one by one they are exact and cost what steps of one cycle would."""
     cyc, e_p = loop.explicit_step(1)
-    r_m, r_s = cyc.rate_moving, cyc.rate_stationary
     loop.jump, loop.lag = 2.0, e_p
+    _remember(loop, cyc)
+    return loop.emit(cyc, 1, e_p)
+
+
+def _remember(loop, cyc) -> None:
+    """An explicit step's state in the BDF2 history (φ = h + ½r of the per-cycle update), so that implicit steps
+    can follow it."""
+    r_m, r_s = cyc.rate_moving, cyc.rate_stationary
     loop.history = (loop.history + [(loop.n, loop.h_m + 0.5 * r_m, loop.h_s + 0.5 * r_s, cyc.pressure,
                                      loop.work + 0.5 * cyc.work,
                                      loop.energy + 0.5 * loop.energy_rate(cyc))])[-HISTORY_POINTS:]
-    return loop.emit(cyc, 1, e_p)
 
 
 def explicit_in_partial_slip(loop) -> bool:
@@ -253,11 +259,8 @@ def _partial_slip_step(loop):
     cyc, e_p = loop.explicit_step(d)
     local = max(relative_to_deepest(loop.err_abs_m - before[0], loop.h_m),
                 relative_to_deepest(loop.err_abs_s - before[1], loop.h_s))
-    r_m, r_s = cyc.rate_moving, cyc.rate_stationary
     loop.jump, loop.lag = next_step(d, local / DEPTH_SHARE, s.step_tolerance, 1), e_p / d
-    loop.history = (loop.history + [(loop.n, loop.h_m + 0.5 * r_m, loop.h_s + 0.5 * r_s, cyc.pressure,
-                                     loop.work + 0.5 * cyc.work,
-                                     loop.energy + 0.5 * loop.energy_rate(cyc))])[-HISTORY_POINTS:]
+    _remember(loop, cyc)
     return loop.emit(cyc, d, e_p)
 
 
