@@ -915,6 +915,10 @@ def _read_blocks(r: "_Reader", raw_load: dict, load: dict, given: list) -> tuple
         vals = {k: r.key(item, k, spec[k], f"{path}.{k}") for k in fields}
         if any(vals[k] is None for k in fields[:3]):
             continue
+        mu = vals["friction_coefficient"]
+        if "friction_coefficient" in item and mu is not None and 0 < mu < MIN_FRICTION:
+            r.fail(f"{path}.friction_coefficient", _tiny_friction(mu))
+            continue
         cycles = 0 if spectrum else vals["cycles"]
         out.append(Block(vals["normal_load"], vals["stroke"], cycles, vals["friction_coefficient"],
                          load.get("tangential_stiffness"), vals["fraction"] if spectrum else None))
@@ -1154,9 +1158,12 @@ def _check_model(r: "_Reader", geometry, materials: dict, model: dict, mu: Optio
         r.fail("loading.friction_coefficient", f"0 with {why}: without friction it has nothing to work with "
                                                f"(no shear traction, no dissipated energy); give μ > 0")
     if mu is not None and 0 < mu < MIN_FRICTION:
-        r.fail("loading.friction_coefficient", f"{mu:g}: expected 0 (frictionless) or at least {MIN_FRICTION:g}; a "
-                                               f"smaller μ is frictionless in all but name, and its shear tractions "
-                                               f"underflow the tangential solve")
+        r.fail("loading.friction_coefficient", _tiny_friction(mu))
+
+
+def _tiny_friction(mu: float) -> str:
+    return (f"{mu:g}: expected 0 (frictionless) or at least {MIN_FRICTION:g}; a smaller μ is frictionless in all but "
+            f"name, and its shear tractions underflow the tangential solve")
 
 
 def _loading(r: "_Reader", load: dict, blocks: Optional[tuple], repeat: int, spectrum: bool) -> Loading:

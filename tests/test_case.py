@@ -171,3 +171,10 @@ def test_a_friction_coefficient_too_small_to_carry_a_traction_is_refused_and_zer
         load_case(path, ["model.dimension=2d", "loading.friction_coefficient=1e-300", "model.slip=coulomb"])
     load_case(path, ["model.dimension=2d", "loading.friction_coefficient=0"])
     load_case(path, ["model.dimension=2d", f"loading.friction_coefficient={MIN_FRICTION}", "model.slip=coulomb"])
+    # ... and inside a load history, where each block may give its own (not checked at first)
+    single = ("loading.normal_load=null", "loading.stroke=null")  # the blocks carry them
+    blocks = ('loading.blocks=[{normal_load: 185 N, stroke: 25 um, cycles: 100, friction_coefficient: 0.9}, '
+              '{normal_load: 100 N, stroke: 25 um, cycles: 100, friction_coefficient: %s}]')
+    with pytest.raises(CaseError, match=r"loading.blocks\[1\].friction_coefficient"):
+        load_case(path, ["model.dimension=2d", "model.slip=coulomb", *single, blocks % "1e-300"])
+    load_case(path, ["model.dimension=2d", "model.slip=coulomb", *single, blocks % MIN_FRICTION])
