@@ -643,6 +643,8 @@ def estimate(setup: Setup, filled: Case, runs: Optional[SideRuns] = None) -> dic
             c_setup, _, _ = prepare(case, runs=runs)
         except (SimulationError, CaseError):
             continue
+        # a companion stops at the run's wear limit as the run does (it plans without a pilot of its own)
+        c_setup = dataclasses.replace(c_setup, expected_stop=min(c_setup.expected_stop, setup.expected_stop))
         out["companions_s"] += estimate_cost(c_setup)[1]
         out["companions"] += 1
     return out

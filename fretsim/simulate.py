@@ -76,6 +76,7 @@ class Setup:
     notes: tuple[str, ...] = ()
     planned_extent: float = 0.0  # mm along x: the grid that holds the final scar the plan expects (a grid that
     #                              follows the contact starts smaller and widens to it: fretsim.regrid.allowed)
+    expected_stop: float = float("inf")  # cycles: where a pilot run reached a wear limit (the cost estimate's end)
     block_cycles: tuple = ()  # a load history: the cycle model of each block of ``loading`` (empty: ``cycle``)
     wear_limits: dict = field(default_factory=dict)  # fretsim.limits: key -> limit (internal units)
     wall: Optional[float] = None  # mm, a tube's wall thickness (the wall_loss limit)

@@ -76,8 +76,10 @@ def prepare(case: Case, allow_unstable: bool = False, runs: Optional[SideRuns] =
                              "`fretsim check` includes it in its time estimate")
     cycles = cycle.build(case, plan, grids, operators, regime, proxy_case, runs, plan_case)
     steps = stepping.build(case, plan, grids, operators, cycles, allow_unstable)
-    return _setup(case, plan, grids, operators, regime, cycles, steps, contact), _filled(case, grids, operators, cycles,
-                                                                                 steps), plan
+    setup = _setup(case, plan, grids, operators, regime, cycles, steps, contact)
+    if expected is not None:
+        setup = dataclasses.replace(setup, expected_stop=float(expected))
+    return setup, _filled(case, grids, operators, cycles, steps), plan
 
 
 def _setup(case: Case, plan: Plan, grids, operators, regime, cycles, steps, contact) -> Setup:
