@@ -7,8 +7,6 @@ from fretsim.quantities import SUMMARY, WEAR
 
 FORMAT_VERSION = "1.5"
 READABLE_FORMATS = ("1.1", "1.2", "1.3", "1.4", "1.5")
-FLUSH_SECONDS = 0.5
-FLUSH_COST_FACTOR = 20.0  # flushes no more often than this many times their own cost (≤ ~5 % of the run)
 STATUSES = ("running", "complete", "interrupted", "failed", "stopped")
 MAX_DATASET_BYTES = 2**32  # 4 GiB: no results file of this tool holds a larger array
 MAX_NAME = 200  # bytes of the output's base name we accept (temporaries use fixed-length names)
