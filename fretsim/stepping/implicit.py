@@ -44,6 +44,12 @@ PARTIAL_SLIP_EXPLICIT = True  # forward-Euler steps while the cycle has a stick 
 # largely cancel (at DEPTH_SHARE McColl's cylinder at 0.4 µm ended 2.9e-3 off the run cycle by cycle after 3 000
 # cycles, at a quarter of it 1.5e-3)
 EXPLICIT_SHARE = DEPTH_SHARE / 4
+# the wear stiffness k·(s + p·∂s/∂p) against k·s_max: the slip answers the pressure too (more pressure, less slip
+# in the annulus).  Measured with error control off (Ti-6Al-4V, 8.2 µm, μ 1.2, 10⁵ cycles): steps of 4δ/(2·s_max)
+# times half the planned limit were stable at 1.5 times that and built a 22 % checkerboard at 2 (a review found
+# 4δ/s_max unstable there): the stiffness is about 2.3·k·s_max (1.7 at 5.5 µm, μ 0.8), and 3 keeps the steps
+# within half the limit it allows, where every mode decays without changing sign
+SLIP_STIFFNESS = 3.0
 
 
 class Implicit:
@@ -256,14 +262,6 @@ def _expects_stick(setup) -> bool:
             and setup.stability_limit > 4.0)
 
 
-# the wear stiffness k·(s + p·∂s/∂p) against k·s_max: the slip answers the pressure too (more pressure, less slip
-# in the annulus).  Measured with error control off (Ti-6Al-4V, 8.2 µm, μ 1.2, 10⁵ cycles): a pure cap of
-# 4δ/(2·s_max) times half the planned limit was stable at 1.5 times itself and built a 22 % checkerboard at 2
-# (4δ/s_max, which a review showed unstable near the transition): the stiffness is about 1.2 s_max there, and 3
-# keeps the steps near half the limit it allows, where every mode decays without changing sign
-SLIP_STIFFNESS = 3.0
-
-
 def _slip_headroom(loop) -> float:
     """How far the stability limit of the cycle's own wear stiffness lies beyond the planned one.  The limit is the
     gross-slip operator's (every point sliding 4δ); no point of this cycle slid further than its largest slip
@@ -276,9 +274,10 @@ def _slip_headroom(loop) -> float:
 
 def _partial_slip_step(loop):
     """A forward-Euler step under error control: at most half the explicit stability limit of the cycle's wear
-    stiffness (every mode decays without changing sign; :func:`_slip_headroom`), sized so its local depth error (½(ΔN − 1)·ΔN·ṙ at the deepest element, as the linear
-    scheme estimates it) stays within the depths' share of the tolerance; kept in the BDF2 history as an exact cycle
-    is, so implicit steps resume from it should the stick zone vanish."""
+    stiffness (every mode decays without changing sign; :func:`_slip_headroom`), sized so its local depth error
+    (½(ΔN − 1)·ΔN·ṙ at the deepest element, as the linear scheme estimates it) stays within EXPLICIT_SHARE of the
+    tolerance; kept in the BDF2 history as an exact cycle is, so implicit steps resume from it should the stick
+    zone vanish."""
     s = loop.s
     cap = s.stability_limit / 2.0 * _slip_headroom(loop)
     d = int(max(1, min(loop.jump, cap, s.max_jump or np.inf, loop.next_stop() - loop.n)))
