@@ -71,8 +71,8 @@ def prepare(case: Case, allow_unstable: bool = False, runs: Optional[SideRuns] =
         refine = finer
     grid.warn_unresolved_stick(case, plan, regime.slip.value, regime.transition, contact, grids.grid)
     if case.stationary.fatigue is not None and not grids.plane:
-        plan.warnings.append("fretting fatigue in 3D: the plane search over the flat's volume costs about 3–4× the wear "
-                             "run in partial slip and 11–60× in gross slip (README: the cost of fatigue); "
+        plan.warnings.append("fretting fatigue in 3D: the plane search over the flat's volume costs about 2.5–3.5× the "
+                             "wear run in partial slip and 9–30× in gross slip (README: the cost of fatigue); "
                              "`fretsim check` includes it in its time estimate")
     cycles = cycle.build(case, plan, grids, operators, regime, proxy_case, runs, plan_case)
     steps = stepping.build(case, plan, grids, operators, cycles, allow_unstable)
