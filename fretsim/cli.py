@@ -198,7 +198,8 @@ def run(case_file: Path | None, output: str | None, overrides: tuple, overwrite:
 def _beyond_accuracy(note: str) -> bool:
     """A run's note that an estimated error exceeds model.accuracy or model.pressure_accuracy (the runner's
     words), as opposed to how the estimates were made."""
-    return "exceeds model.accuracy" in note or "exceeds model.pressure_accuracy" in note
+    return ("exceeds model.accuracy" in note or "exceeds model.pressure_accuracy" in note
+            or "too coarse for the numbers to have converged" in note or "has no converged value" in note)
 
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
@@ -428,9 +429,11 @@ def _estimates(s: dict) -> str:
                 f"{s['error_estimate_pressure']:.1e}")
     if math.isnan(s.get("estimated_error_depth", float("nan"))):
         return f"Estimated error (relative): the grid's part not estimated; {stepping}."
+    peak = s["estimated_error_max_pressure"]
+    peak = "not estimated (it grows as the grid is refined)" if math.isnan(peak) else f"{peak:.1e}"
     return (f"Estimated error (relative; stepping, grid and model): depth {s['estimated_error_depth']:.1e}, scar "
             f"width {s['estimated_error_width']:.1e}, pressure field {s['estimated_error_pressure']:.1e}, its peak "
-            f"{s['estimated_error_max_pressure']:.1e} ({stepping}).")
+            f"{peak} ({stepping}).")
 
 
 def _limits(s: dict, c) -> str:

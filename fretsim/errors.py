@@ -33,6 +33,12 @@ class NumericalFailure(SimulationError):
     """No convergence, NaN, instability or a broken invariant."""
 
 
+class GridFeedback(NumericalFailure):
+    """An odd-even pressure pattern the cycle model itself grew under steps with no stability limit: where a contact
+    partly sticks, more pressure means less slip and less wear, and on too coarse a grid that feedback grows at the
+    stick zone's edge.  A finer grid carries it (:func:`fretsim.runner.run` refines an automatic grid)."""
+
+
 class DomainError(SimulationError):
     """The contact outgrew the grid (``axis``: the edge it reached, 'x' or 'y')."""
 

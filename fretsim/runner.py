@@ -19,6 +19,7 @@ import numpy as np
 
 from fretsim import grid_error, heap, regrid
 from fretsim.case import GEOMETRY_KEYS, Case, CaseError, parse_case
+from fretsim.errors import GridFeedback
 from fretsim.plan import Plan, SideRuns, estimate_cost, prepare, restore
 from fretsim.plan.cycle import strip_compliances
 from fretsim.reference import effective_modulus
@@ -43,6 +44,7 @@ class Outcome:
     notes: tuple = field(default_factory=tuple)
     plan: Optional[Plan] = None
     written: bool = False  # whether the results file holds this run's steps
+    failure: Optional[Exception] = None  # what stopped a failed run (the loop's SimulationError)
 
 
 # a step's odd-even pressure pattern, relative to its mean, worth a note: the growth watcher stops only a
@@ -62,6 +64,7 @@ class _Counter:
         self.last = None
         self.errors = tuple(errors)
         self.board = 0.0  # the largest odd-even pressure amplitude of a step past CHECKERBOARD_NOTE
+        self.failure: Optional[Exception] = None  # what stopped the loop, where it failed
 
     def on_step(self, setup, step):
         self.solves += 1
@@ -170,11 +173,61 @@ def run(case: Case, output: Optional[str | Path] = None, *, overwrite: bool = Fa
     try:
         if on_plan is not None:
             on_plan(setup, filled, plan)
-        sink = _Sink(output, setup, filled, plan, overwrite, None, case.fingerprint())
-        return _execute(setup, filled, plan, sink, progress, observers, None, runs)
+        refinements: list = []
+        while True:
+            sink = _Sink(output, setup, filled, plan, overwrite, None, case.fingerprint())
+            outcome = _execute(setup, filled, plan, sink, progress, observers, None, runs, tuple(refinements))
+            again = _refined(outcome, setup, filled, plan, runs, len(refinements))
+            if again is None:
+                if refinements and outcome.status == "failed":
+                    outcome.message += f" (on the automatic grid refined {len(refinements)}× already: its notes)"
+                return outcome
+            setup, filled, plan, note = again
+            refinements.append(note)
+            runs.say(note)
+            overwrite = overwrite or outcome.written  # (the file is this run's own now: the next attempt replaces it)
     finally:
         if claim is not None:
             claim.release()
+
+
+MAX_REFINEMENTS = (2, 1)  # an automatic grid refined 2× per time for a GridFeedback: in 2D, in 3D (4× the elements)
+
+
+def _refined(outcome: Outcome, setup: Setup, filled: Case, plan: Plan, runs: SideRuns, done: int):
+    """Where a run on an automatic grid failed with an odd-even pattern its cycle model grew on that grid (a
+    :class:`~fretsim.errors.GridFeedback`: a partial slip's stick edge on too coarse a grid), the case on a grid
+    twice as fine along x (and y for a point contact), to run again from the start: (setup, filled case, plan with
+    the refined choice, the note that says so); None otherwise, or after MAX_REFINEMENTS."""
+    exc, plane = outcome.failure, setup.grid.plane_strain
+    if not isinstance(exc, GridFeedback) or not regrid.grid_is_automatic(plan) or done >= MAX_REFINEMENTS[not plane]:
+        return None
+    line_contact = setup.y_edges_free and not plane
+    e = filled.elements
+    elements = (grid_error.odd(2 * e[0]),) + (() if len(e) == 1 else (e[1],) if line_contact else
+                                               (grid_error.odd(2 * e[1]),))
+    coarse = None if filled.coarse_element is None else tuple(c / 2 for c in filled.coarse_element)
+    try:
+        new_setup, new_filled, new_plan = prepare(filled.with_choices(elements=elements, coarse_element=coarse),
+                                                  runs=runs)
+    except CaseError:  # e.g. more memory than the machine has: the failure stands
+        return None
+    old, new = " × ".join(map(str, e)), " × ".join(map(str, elements))
+    note = (f"the automatic grid was refined from {old} to {new} elements and the run started again: on {old} the "
+            f"pressure checkerboarded at cycle {exc.cycle:,} (the Coulomb cycle's feedback at its stick zone's edge, "
+            f"which a finer grid carries)")
+    # the choices as a resume plans them (fretsim.plan.restore): the first plan's provenance, the values of the
+    # refined grid where they were automatic (the stability limit's reference jump moves with the element)
+    first = {c.key: c for c in plan.choices}
+    choices = []
+    for c in new_plan.choices:
+        o = first.get(c.key)
+        if o is not None:
+            c = dataclasses.replace(c, value=o.value if o.given else c.value, reason=o.reason, given=o.given,
+                                    error=o.error)
+        choices.append(dataclasses.replace(c, reason=f"{c.reason}; {note}") if c.key == "grid.elements" else c)
+    return (dataclasses.replace(new_setup, notes=tuple(setup.notes)), new_filled,
+            dataclasses.replace(new_plan, choices=choices, warnings=plan.warnings), note)
 
 
 def _claim(path: Path) -> OutputClaim:
@@ -346,9 +399,10 @@ def _io_outcome(exc, sink: "_Sink", setup, filled, plan, counter, t0) -> Outcome
 
 
 def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from: Optional[Results],
-             runs: SideRuns) -> Outcome:
+             runs: SideRuns, notes: tuple = ()) -> Outcome:
     counter = _Counter(len(resume_from.history["cycle"]) if resume_from is not None else 0,
                        _recorded_errors(resume_from) if resume_from is not None else (0.0, 0.0))
+    counter.notes.extend(notes)
     t0 = time.perf_counter()
     state = resume_from.checkpoint if resume_from is not None else None
     output = sink.output
@@ -374,7 +428,8 @@ def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from:
     finally:
         _restore_signals(previous)
     return Outcome(status, message, _summary(setup, counter, t0), setup, filled, Path(output) if output else None,
-                   counter.last, tuple(setup.notes) + tuple(counter.notes), plan, sink.writer is not None)
+                   counter.last, tuple(setup.notes) + tuple(counter.notes), plan, sink.writer is not None,
+                   counter.failure)
 
 
 def _simulate(counter, sink: _Sink, observers, progress, state, runs: SideRuns) -> tuple[str, str]:
@@ -518,6 +573,7 @@ def _simulate_on(setup, plan, counter, sink: _Sink, observers, progress, state) 
     except PhysicalLimit as exc:
         return "stopped", str(exc)
     except SimulationError as exc:
+        counter.failure = exc
         return "failed", str(exc)
     if counter.last is None and last is not None:  # resumed at its end: nothing left to do
         counter.last = last
@@ -614,10 +670,9 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
                                         f"{', coarsened where the run was' if replay else ''}) to estimate the grid's "
                                         f"part of the error", c_setup, c_filled, replay, widen)
     except (SimulationError, CaseError) as exc:  # e.g. the mid-stroke gap, stable on the run's grid, is not on
-        #                                           the coarser one: the run stands, its grid error is unknown
-        counter.notes.append(f"the grid's error was not estimated: its companion run on a grid twice as coarse "
-                             f"stopped ({str(exc)[:160]})")
-        return {**grid_error.totals(summary, None, model_part), grid_error.LIMIT_KEY: float("nan")}
+        #  the coarser one, or a partial slip's stick edge breaks into a checkerboard there: the run stands, and a
+        #  companion twice as fine says how far it is from the converged answer
+        return _finer_estimates(setup, filled, counter, runs, summary, model_part, first, replay, widen, exc)
     coarse = summarize(c_setup, last, 0, 0.0)
     coarsest = _coarsest(coarsest_case, runs, replay, widen)
     part = grid_error.grid_estimates(summary, coarse, counter.last.pressure, setup.grid, last.pressure,
@@ -630,7 +685,10 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
     if counter.last.limit is not None and not math.isfinite(out[grid_error.LIMIT_KEY]):
         counter.notes.append("the grid's part of cycles_to_limit was not estimated: the companion run on a grid "
                              "twice as coarse reached no limit within loading.cycles")
-    if not part["peak_converging"]:
+    if part["peak_diverging"]:
+        counter.notes.append(grid_error.diverging_note(summary["max_pressure_MPa"], coarse["max_pressure_MPa"],
+                                                       coarsest["max_pressure_MPa"]))
+    elif not part["peak_converging"]:
         counter.notes.append(grid_error.peak_note(summary["max_pressure_MPa"], coarse["max_pressure_MPa"],
                                                   coarsest["max_pressure_MPa"], out["estimated_error_max_pressure"]))
     over = [f"{what} {out[key]:.2%}" for key, what in (("estimated_error_depth", "the depths"),
@@ -643,6 +701,37 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
         counter.notes.append(f"the estimated error of {' and of '.join(over)} exceeds model.accuracy "
                              f"({filled.accuracy:.2%}); a finer grid.elements (the companion grid's difference is "
                              f"most of it) or a smaller jumping.tolerance brings it down")
+    return out
+
+
+def _finer_estimates(setup: Setup, filled: Case, counter: "_Counter", runs: SideRuns, summary: dict,
+                     model_part: float, first: Optional[Case], replay: tuple, widen: bool, why: Exception) -> dict:
+    """The grid's part of the error where the companion twice as coarse stopped: from a companion twice as fine
+    (:func:`fretsim.grid_error.finer_estimates`); unknown, and said so as a warning, where that stops too.  A coarse
+    companion that breaks down is itself a sign that the run's grid is close to too coarse: its numbers may be far
+    from converged, which is why they are not left without an estimate."""
+    stopped = str(why).splitlines()[0][:160]
+    line_contact = setup.y_edges_free and not setup.grid.plane_strain
+    finer = grid_error.companion_case(first if first is not None else filled, line_contact, times=-1)
+    try:
+        f_setup, f_filled, _ = prepare(finer, runs=runs)
+        last, f_setup = _side_run(runs, f"grid error: the companion on a grid twice as coarse stopped; the case again "
+                                        f"on a grid twice as fine ({f_setup.grid.shape[1]} × {f_setup.grid.shape[0]} "
+                                        f"elements) instead", f_setup, f_filled, replay, widen)
+    except (SimulationError, CaseError) as exc:
+        counter.notes.append(f"the grid's error was not estimated: its companion run on a grid twice as "
+                             f"coarse stopped ({stopped}), and one on a grid twice as fine stopped too "
+                             f"({str(exc).splitlines()[0][:160]}); this grid may be too coarse for the numbers to "
+                             f"have converged: compare with a run on a finer grid.elements")
+        return {**grid_error.totals(summary, None, model_part), grid_error.LIMIT_KEY: float("nan")}
+    fine = summarize(f_setup, last, 0, 0.0)
+    part = grid_error.finer_estimates(summary, fine, counter.last.pressure, setup.grid, last.pressure, f_setup.grid)
+    out = grid_error.totals(summary, part, model_part)
+    out[grid_error.LIMIT_KEY] = grid_error.cycles_to_limit_estimate(summary, fine, counter.last.limit, model_part,
+                                                                    grid_error.FINER_FACTOR)
+    if setup.fatigue is not None:
+        out.update(grid_error.fatigue_estimates(summary, fine, grid_error.FINER_FACTOR))
+    counter.notes.append(grid_error.finer_note(stopped, f_setup.grid.shape[1], out, filled.accuracy))
     return out
 
 

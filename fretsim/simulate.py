@@ -266,7 +266,8 @@ class _Loop:
         checks.check_invariant(step.archard_error, self.model.invariant, self.n)
         checks.check_bounds(self.model, cyc, self.work, self.n, blocks.work_bound(self))
         if self.n > 0 and self.watch.update(step.checkerboard) and s.watch_growth:
-            raise checks.growth_failure(self.n, step.checkerboard, s.stepper.growth_cause(s, self.model))
+            raise checks.growth_failure(self.n, step.checkerboard, s.stepper.growth_cause(s, self.model),
+                                        checks.grows_on_grid(self.model, s.stepper.implicit))
         step.block = self.block
         verdict = self.landing.check(self, step) if s.wear_limits and self.n > 0 else None
         if verdict == "retake":

@@ -516,3 +516,57 @@ def test_the_widenings_a_grid_that_follows_the_contact_plans_do_not_use_up_the_m
     out = run(load_case(TUBE, TUBE_SETS))
     assert out.status == "complete" and out.summary["limit_reached"], out.message
     assert sum("widened along x" in n for n in out.notes) >= 2
+
+
+# Ti-6Al-4V with the moving body wearing a tenth of the flat, μ 1.2, 8 µm (cases/ti_fretting_fatigue.yaml): a stick
+# zone of a few elements whose edge builds an odd-even pressure pattern on the automatic 185 elements at ~15 300 cycles
+UNEQUAL = ["materials.moving.wear_coefficient=2.75e-9 1/MPa", "loading.friction_coefficient=1.2",
+           "loading.stroke=8 um", "materials.stationary.fatigue=null", "loading.cycles=40000"]
+TI = CASE.parent / "ti_fretting_fatigue.yaml"
+
+
+def test_an_automatic_grid_whose_stick_edge_checkerboards_is_refined_and_run_again_and_a_users_grid_is_not(tmp_path):
+    """Before, the run failed at cycle 15 330 ("refine the grid"), what the tool could do itself for a grid it chose;
+    now it runs again from the start on twice the elements, says so, and records the refined grid as an automatic
+    choice.  The user's own grid of the same elements fails as before (a given grid is never changed)."""
+    out = run(load_case(TI, UNEQUAL), tmp_path / "auto.h5")
+    assert out.status == "complete", out.message
+    note = next(n for n in out.notes if n.startswith("the automatic grid was refined"))
+    assert "from 185 to 371 elements" in note and "checkerboarded at cycle 15,330" in note
+    r = read_results(tmp_path / "auto.h5")
+    assert r.x.size == 371 and not r.regrids and r.history["cycle"][0] == 0 and r.history["cycle"][-1] == 40000
+    choice = next(c for c in out.plan.choices if c.key == "grid.elements")
+    assert choice.value == (371,) and not choice.given and "refined from 185" in choice.reason
+    # the same run on the refined grid given from the start: the same numbers (the first attempt left nothing)
+    domain = f"grid.domain=[{float(out.case.domain[0])!r} mm]"  # (refining keeps the domain)
+    given = run(load_case(TI, [*UNEQUAL, domain, "grid.elements=[371]"]))
+    for key in ("max_wear_depth_moving_um", "max_wear_depth_stationary_um", "scar_width_stationary_mm"):
+        assert out.summary[key] == pytest.approx(given.summary[key], rel=1e-12), key
+    users = run(load_case(TI, [*UNEQUAL, domain, "grid.elements=[185]", "grid.error_estimate=none"]))
+    assert users.status == "failed" and "checkerboards at cycle" in users.message
+    assert not any(n.startswith("the automatic grid was refined") for n in users.notes)
+
+
+def test_a_run_interrupted_after_its_grid_was_refined_resumes_on_the_refined_grid_bit_for_bit(tmp_path):
+    whole = run(load_case(TI, [*UNEQUAL, "grid.error_estimate=none"]), tmp_path / "whole.h5")
+    with pytest.raises(KeyboardInterrupt):  # the first attempt's steps, then 40 of the refined run's
+        run(load_case(TI, [*UNEQUAL, "grid.error_estimate=none"]), tmp_path / "cut.h5", observers=(_CtrlC(),))
+    cut = read_results(tmp_path / "cut.h5")
+    assert cut.status == "interrupted" and cut.x.size == 371 and 0 < cut.history["cycle"][-1] < 40000
+    assert resume(tmp_path / "cut.h5").status == "complete"
+    a, b = read_results(tmp_path / "whole.h5"), read_results(tmp_path / "cut.h5")
+    assert np.array_equal(a.fields["wear_depth_stationary"], b.fields["wear_depth_stationary"])
+    assert np.array_equal(a.history["cycle"], b.history["cycle"]) and b.choices == a.choices
+
+
+class _CtrlC:
+    """Ctrl-C at the refined run's 40th step (its steps start again from cycle 0)."""
+
+    def __init__(self):
+        self.restarted, self.count = False, 0
+
+    def on_step(self, setup, step):
+        if setup.grid.shape[1] == 371:
+            self.count += 1
+            if self.count == 40:
+                raise KeyboardInterrupt

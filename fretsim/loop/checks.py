@@ -11,7 +11,7 @@ from typing import Optional
 
 import numpy as np
 
-from fretsim.errors import DomainError, NumericalFailure, PhysicalLimit, ResolutionError
+from fretsim.errors import DomainError, GridFeedback, NumericalFailure, PhysicalLimit, ResolutionError
 
 MIN_ELEMENTS_ACROSS_CONTACT = 4
 ARCHARD_ROUND_OFF = 1e-9  # the volume is the invariant's (k·P·4δ·N, k·Σp|ds|A) by construction; more is a bug
@@ -87,10 +87,20 @@ def check_bounds(model, cyc, work: float, cycle: int, work_max: Optional[float] 
         raise NumericalFailure(f"a physical bound is broken at cycle {cycle}: {what}", cycle)
 
 
-def growth_failure(n: int, amplitude: float, cause: str) -> NumericalFailure:
-    """The failure of a run whose pressure grew an odd-even pattern; ``cause`` is the stepping scheme's reading."""
-    return NumericalFailure(f"the pressure checkerboards at cycle {n}: an odd-even pattern grew over the last steps "
-                            f"(amplitude {abs(amplitude):.1%} of the mean pressure); {cause}", n)
+def growth_failure(n: int, amplitude: float, cause: str, on_grid: bool = False) -> NumericalFailure:
+    """The failure of a run whose pressure grew an odd-even pattern; ``cause`` is the stepping scheme's reading,
+    ``on_grid`` whether the cycle model grew it on too coarse a grid (:func:`grows_on_grid`: a GridFeedback)."""
+    kind = GridFeedback if on_grid else NumericalFailure
+    return kind(f"the pressure checkerboards at cycle {n}: an odd-even pattern grew over the last steps "
+                f"(amplitude {abs(amplitude):.1%} of the mean pressure); {cause}", n)
+
+
+def grows_on_grid(model, implicit: bool) -> bool:
+    """Whether a growing odd-even pattern is the cycle model's feedback on its grid, which a finer grid carries:
+    a Coulomb cycle at the mid-stroke (its stick zone's edge) under steps with no stability limit — not an
+    explicit step past its limit, nor the resolved stroke's reading of the flat between its positions."""
+    return implicit and not model.linear and not (getattr(model, "resolved", False)
+                                                  and not getattr(model, "rigid", False))
 
 
 def model_growth_cause(model, setup) -> str:

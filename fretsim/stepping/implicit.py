@@ -157,8 +157,10 @@ def _accept(loop, cyc, d: int, partner: Optional[int], base: tuple, g: float, ha
     new_phi_e = base[3] + g * d * rate_e
     h_m, h_s = new_phi_m - half * r_m, new_phi_s - half * r_s
     err_m, err_s, k_order = _local_errors(loop, partner, d, p_now, p_new, r_m, r_s, new_phi_m, new_phi_s, h_m, h_s)
-    # a non-linear cycle: what its linearised implicit solve got wrong, counted in both bodies' errors
-    err_m, err_s = err_m + cyc.defect, err_s + cyc.defect
+    # a non-linear cycle: what its linearised implicit solve got wrong, a gap's (both bodies' wear), shared
+    # between the bodies as their wear is (defect_shares)
+    share_m, share_s = defect_shares(r_m, r_s)
+    err_m, err_s = err_m + share_m * cyc.defect, err_s + share_s * cyc.defect
     error = max(relative_to_deepest(err_m, h_m), relative_to_deepest(err_s, h_s)) / DEPTH_SHARE
     if error > 1.5 * tol and d > 1:
         loop.rejected += 1
@@ -292,6 +294,17 @@ def _partial_slip_step(loop):
     loop.jump, loop.lag = next_step(d, local / EXPLICIT_SHARE, s.step_tolerance, 1), e_p / d
     _remember(loop, cyc)
     return loop.emit(cyc, d, e_p)
+
+
+def defect_shares(r_m: np.ndarray, r_s: np.ndarray) -> tuple[float, float]:
+    """Each body's share of a step's defect (:attr:`fretsim.cycle.result.Cycle.defect`: the wear of both bodies the
+    linearised solve got wrong, as a gap): a gap error moves the pressure, and the pressure's change wears each body
+    as its own wear does (its k, or α, times the same traction and slip), so the shares are the bodies' wear
+    volumes in the step.  Counted whole in both, a moving body wearing a fifteenth of the flat (the energy law, α_m
+    = α_s/15) had its relative depth error over-estimated 15×: its steps shrank to hold it (1053 solves over 2·10⁵
+    cycles) and the run reported 17 % against an error of 2e-5."""
+    v_m, v_s = float(np.abs(r_m).sum()), float(np.abs(r_s).sum())
+    return (v_m / (v_m + v_s), v_s / (v_m + v_s)) if v_m + v_s > 0 else (0.5, 0.5)
 
 
 def relative_to_deepest(err: float, h: np.ndarray) -> float:
