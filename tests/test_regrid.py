@@ -570,3 +570,24 @@ class _CtrlC:
             self.count += 1
             if self.count == 40:
                 raise KeyboardInterrupt
+
+
+def test_a_refinement_doubles_a_point_contacts_elements_along_both_axes_a_line_contacts_along_x_once_in_3d():
+    """runner._refined on synthetic failures (a 3D GridFeedback is rare to provoke: the shipped ball at μ 1.2 with
+    k_m = k_s/10 completes): a ball's grid doubles along x and y, a cylinder's (a line contact: its 27 rows are the
+    paper's, where 3D differs) along x only; 3D refines once (4× the elements), and nothing but a GridFeedback on an
+    automatic grid is refined."""
+    from fretsim.errors import GridFeedback, NumericalFailure
+    from fretsim.plan import SideRuns, prepare
+    from fretsim.runner import Outcome, _refined
+    feedback = GridFeedback("the pressure checkerboards at cycle 900", 900)
+    for name, line in (("ball_partial_slip", False), ("mccoll_185N", True)):
+        setup, filled, plan = prepare(load_case(CASE.parent / f"{name}.yaml", ["grid.error_estimate=none"]))
+        outcome = Outcome("failed", str(feedback), {}, setup, filled, None, failure=feedback)
+        again = _refined(outcome, setup, filled, plan, SideRuns(), 0)
+        nx, ny = filled.elements
+        assert again[1].elements == ((2 * nx) | 1, ny if line else (2 * ny) | 1), name
+        assert "refined from" in next(c.reason for c in again[2].choices if c.key == "grid.elements")
+        assert _refined(outcome, setup, filled, plan, SideRuns(), 1) is None  # once in 3D
+        other = Outcome("failed", "x", {}, setup, filled, None, failure=NumericalFailure("x", 900))
+        assert _refined(other, setup, filled, plan, SideRuns(), 0) is None
