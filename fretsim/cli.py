@@ -199,7 +199,8 @@ def _beyond_accuracy(note: str) -> bool:
     """A run's note that an estimated error exceeds model.accuracy or model.pressure_accuracy (the runner's
     words), as opposed to how the estimates were made."""
     return ("exceeds model.accuracy" in note or "exceeds model.pressure_accuracy" in note
-            or "too coarse for the numbers to have converged" in note or "has no converged value" in note)
+            or "too coarse for the numbers to have converged" in note or "is not estimated (NaN)" in note
+            or "are not estimated (NaN)" in note)
 
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
@@ -430,7 +431,7 @@ def _estimates(s: dict) -> str:
     if math.isnan(s.get("estimated_error_depth", float("nan"))):
         return f"Estimated error (relative): the grid's part not estimated; {stepping}."
     peak = s["estimated_error_max_pressure"]
-    peak = "not estimated (it grows as the grid is refined)" if math.isnan(peak) else f"{peak:.1e}"
+    peak = "not estimated (partial slip: the stick zone's edge)" if math.isnan(peak) else f"{peak:.1e}"
     return (f"Estimated error (relative; stepping, grid and model): depth {s['estimated_error_depth']:.1e}, scar "
             f"width {s['estimated_error_width']:.1e}, pressure field {s['estimated_error_pressure']:.1e}, its peak "
             f"{peak} ({stepping}).")

@@ -21,6 +21,7 @@ from fretsim import grid_error, heap, regrid
 from fretsim.case import GEOMETRY_KEYS, Case, CaseError, parse_case
 from fretsim.errors import GridFeedback
 from fretsim.plan import Plan, SideRuns, estimate_cost, prepare, restore
+from fretsim.plan import _notes as plan_notes
 from fretsim.plan.cycle import strip_compliances
 from fretsim.reference import effective_modulus
 from fretsim.results import (OutputBusy, OutputClaim, Results, ResultsIOError, ResultsWriter, check_output_path,
@@ -173,22 +174,44 @@ def run(case: Case, output: Optional[str | Path] = None, *, overwrite: bool = Fa
     try:
         if on_plan is not None:
             on_plan(setup, filled, plan)
-        refinements: list = []
-        while True:
-            sink = _Sink(output, setup, filled, plan, overwrite, None, case.fingerprint())
-            outcome = _execute(setup, filled, plan, sink, progress, observers, None, runs, tuple(refinements))
-            again = _refined(outcome, setup, filled, plan, runs, len(refinements))
-            if again is None:
-                if refinements and outcome.status == "failed":
-                    outcome.message += f" (on the automatic grid refined {len(refinements)}× already: its notes)"
-                return outcome
-            setup, filled, plan, note = again
-            refinements.append(note)
-            runs.say(note)
-            overwrite = overwrite or outcome.written  # (the file is this run's own now: the next attempt replaces it)
+        sink = _Sink(output, setup, filled, plan, overwrite, None, case.fingerprint())
+        outcome = _execute(setup, filled, plan, sink, progress, observers, None, runs)
+        return _refining(outcome, (setup, filled, plan), output, overwrite, case.fingerprint(), progress, observers,
+                         runs, 0)
     finally:
         if claim is not None:
             claim.release()
+
+
+def _refining(outcome: Outcome, planned: tuple, output, overwrite: bool, fingerprint: str, progress, observers,
+              runs: SideRuns, done: int) -> Outcome:
+    """The run again from its start on a finer automatic grid while it fails with a GridFeedback (:func:`_refined`),
+    ``done`` refinements made before (a resumed run's); the last attempt's outcome.  The failed attempt's results
+    file is removed first: a kill before the next attempt's first write then leaves no file (the CLI says nothing
+    was written, and the case runs again), never a 'failed' one that the next attempt was about to replace."""
+    setup, filled, plan = planned
+    notes: list = []
+    while True:
+        again = _refined(outcome, setup, filled, plan, runs, done + len(notes))
+        if again is None:
+            if notes and outcome.status == "failed":
+                outcome.message += f" (on the automatic grid refined {len(notes)}× already: its notes)"
+            return outcome
+        setup, filled, plan, note = again
+        notes.append(f"{note}; the discarded attempt's {outcome.summary.get('contact_solves', 0)} solves are not in "
+                     f"contact_solves")
+        overwrite = overwrite or outcome.written  # (the file is this run's own now: the next attempt replaces it)
+        if output is not None and outcome.written:
+            Path(output).unlink(missing_ok=True)
+        sink = _Sink(output, setup, filled, plan, overwrite, None, fingerprint)
+        runs.say(note)  # (the owner's bar for the first attempt stops here; the next attempt gets one of its own)
+        with runs._progress(setup) as bar:
+            outcome = _execute(setup, filled, plan, sink, bar or progress, observers, None, runs, tuple(notes))
+
+
+def _refinements_made(plan: Plan) -> int:
+    """How many times a resumed run's automatic grid was refined already (its grid.elements choice says)."""
+    return sum(c.reason.count("the automatic grid was refined from") for c in plan.choices if c.key == "grid.elements")
 
 
 MAX_REFINEMENTS = (2, 1)  # an automatic grid refined 2× per time for a GridFeedback: in 2D, in 3D (4× the elements)
@@ -203,13 +226,11 @@ def _refined(outcome: Outcome, setup: Setup, filled: Case, plan: Plan, runs: Sid
     if not isinstance(exc, GridFeedback) or not regrid.grid_is_automatic(plan) or done >= MAX_REFINEMENTS[not plane]:
         return None
     line_contact = setup.y_edges_free and not plane
-    e = filled.elements
+    e = filled.elements  # (a Coulomb cycle refuses refinement's coarse grid: grid.coarse_element is None here)
     elements = (grid_error.odd(2 * e[0]),) + (() if len(e) == 1 else (e[1],) if line_contact else
                                                (grid_error.odd(2 * e[1]),))
-    coarse = None if filled.coarse_element is None else tuple(c / 2 for c in filled.coarse_element)
     try:
-        new_setup, new_filled, new_plan = prepare(filled.with_choices(elements=elements, coarse_element=coarse),
-                                                  runs=runs)
+        new_setup, new_filled, new_plan = prepare(filled.with_choices(elements=elements), runs=runs)
     except CaseError:  # e.g. more memory than the machine has: the failure stands
         return None
     old, new = " × ".join(map(str, e)), " × ".join(map(str, elements))
@@ -226,8 +247,10 @@ def _refined(outcome: Outcome, setup: Setup, filled: Case, plan: Plan, runs: Sid
             c = dataclasses.replace(c, value=o.value if o.given else c.value, reason=o.reason, given=o.given,
                                     error=o.error)
         choices.append(dataclasses.replace(c, reason=f"{c.reason}; {note}") if c.key == "grid.elements" else c)
-    return (dataclasses.replace(new_setup, notes=tuple(setup.notes)), new_filled,
-            dataclasses.replace(new_plan, choices=choices, warnings=plan.warnings), note)
+    # the refined plan's warnings, of the refined grid (an unresolved stick zone's says which grid it means)
+    warnings = [w.replace("(grid.elements is given)", "(the automatic grid, refined)") for w in new_plan.warnings]
+    plan = dataclasses.replace(new_plan, choices=choices, warnings=warnings)
+    return dataclasses.replace(new_setup, notes=plan_notes(plan)), new_filled, plan, note
 
 
 def _claim(path: Path) -> OutputClaim:
@@ -282,7 +305,11 @@ def resume(output: str | Path, *, progress: Optional[Callable[[int], None]] = No
             previous = dataclasses.replace(previous, checkpoint={
                 k: regrid.restrict(v, setup.grid.shape, factor) for k, v in previous.checkpoint.items()})
             setup = sink.setup
-        return _execute(setup, filled, plan, sink, progress, observers, previous, runs)
+        outcome = _execute(setup, filled, plan, sink, progress, observers, previous, runs)
+        # (an attempt interrupted before its grid was refined refines on resuming, as the whole run would have)
+        return _refining(outcome, (setup, filled, plan), output, True,
+                         str(previous.attrs.get("input_sha256", "")), progress, observers, runs,
+                         _refinements_made(plan))
     finally:
         if claim is not None:
             claim.release()
@@ -680,14 +707,19 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
     out = grid_error.totals(summary, part, model_part)
     out[grid_error.LIMIT_KEY] = grid_error.cycles_to_limit_estimate(summary, coarse, counter.last.limit, model_part)
     if setup.fatigue is not None:
-        out.update(grid_error.fatigue_estimates(summary, coarse))
+        out.update(grid_error.fatigue_estimates(summary, coarse, coarsest=coarsest))
+        counter.notes.extend(grid_error.fatigue_diverging_note(grid_error.fatigue_diverging(summary, coarse, coarsest)))
         counter.notes.extend(grid_error.fatigue_over(summary, coarse, out, filled.accuracy))
+        if math.isfinite(summary.get("fatigue_damage_moving", math.nan)):  # (the estimates are the flat's)
+            counter.notes.append("the moving body's fatigue figures (cycles_to_crack_initiation_moving, "
+                                 "swt_max_moving_MPa, fatigue_damage_moving) carry no error estimate: the "
+                                 "estimated_error_* of the fatigue are the flat's")
     if counter.last.limit is not None and not math.isfinite(out[grid_error.LIMIT_KEY]):
         counter.notes.append("the grid's part of cycles_to_limit was not estimated: the companion run on a grid "
                              "twice as coarse reached no limit within loading.cycles")
     if part["peak_diverging"]:
         counter.notes.append(grid_error.diverging_note(summary["max_pressure_MPa"], coarse["max_pressure_MPa"],
-                                                       coarsest["max_pressure_MPa"]))
+                                                       None if coarsest is None else coarsest["max_pressure_MPa"]))
     elif not part["peak_converging"]:
         counter.notes.append(grid_error.peak_note(summary["max_pressure_MPa"], coarse["max_pressure_MPa"],
                                                   coarsest["max_pressure_MPa"], out["estimated_error_max_pressure"]))

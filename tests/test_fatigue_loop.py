@@ -506,19 +506,19 @@ def test_a_recorded_state_at_fixed_pressure_takes_its_fatigue_states_loop_and_th
 
 def test_miners_sum_at_the_end_carries_an_estimate_and_a_note_where_it_exceeds_the_accuracy():
     """A run without a crack reports Miner's sum at its end (fatigue_damage): its estimated error is the companion
-    grid's difference plus the depths' stepping part plus the states' spacing part, as the crack cycle's is; above
-    model.accuracy the run says so, part by part (a gross-slip Ti run at 25 µm: 14 % from the states' spacing alone,
-    which the summary showed with no word of it)."""
+    grid's part (read as a peak's, √h: grid_error.fatigue_estimates) plus the depths' stepping part plus the states'
+    spacing part; above model.accuracy the run says so, part by part (a gross-slip Ti run at 25 µm: 14 % from the
+    states' spacing alone, which the summary showed with no word of it)."""
     from fretsim.cli import _body_fatigue
-    from fretsim.grid_error import fatigue_estimates, fatigue_over
+    from fretsim.grid_error import SQRT_H, fatigue_estimates, fatigue_over
     fine = {"fatigue_damage": 0.103, "fatigue_states_error": 0.142, "error_estimate_depth": 0.003,
             "cycles_to_crack_initiation": float("nan"), "swt_max_MPa": 6.19}
     coarse = {"fatigue_damage": 0.092, "cycles_to_crack_initiation": float("nan"), "swt_max_MPa": 6.0}
     est = fatigue_estimates(fine, coarse)
-    assert est["estimated_error_fatigue_damage"] == pytest.approx(0.011 / 0.103 + 0.003 + 0.142, rel=1e-12)
+    assert est["estimated_error_fatigue_damage"] == pytest.approx(SQRT_H * 0.011 / 0.103 + 0.003 + 0.142, rel=1e-12)
     assert math.isnan(est["estimated_error_cycles_to_crack"])
     [note] = fatigue_over(fine, coarse, est, 0.01)
-    assert "Miner's sum at the end 25.2%" in note and "spacing 14.2%" in note and "grid's 10.7%" in note
+    assert "Miner's sum at the end 40.3%" in note and "spacing 14.2%" in note and "grid's 25.8%" in note
     assert fatigue_over(fine, coarse, est, 0.5) == []
     assert math.isnan(fatigue_estimates({**fine, "fatigue_damage": 0.0}, coarse)["estimated_error_fatigue_damage"])
     cracked = {**fine, "cycles_to_crack_initiation": 8412.0}

@@ -865,22 +865,23 @@ def test_implicit_steps_of_the_resolved_stroke_stay_within_their_estimate_as_exp
             assert explicit.summary[key] == pytest.approx(exact.summary[key], rel=5e-3)
 
 
-def test_a_steps_linearisation_defect_is_shared_between_the_bodies_as_their_wear_is():
-    """The implicit Coulomb step's defect is a gap's: both bodies' wear that the linearised solve got wrong.  Counted
-    whole in each body's error, a moving body wearing a fifteenth of the flat (energy law, α_m = α_s/15, McColl's
-    cylinder at 1 µm, gross slip) had its relative depth error over-estimated 15×: the steps shrank to hold it
-    (1 053 solves over 2·10⁵ cycles) and the run reported 17 % against 2e-5 (a review's finding).  Shared as the
-    wear is, the estimate still covers the error against a run at a 20× tighter tolerance (the reference), and the
-    steps are the flat's: 248 solves measured (the bound, 500, is half the old count), 2.4 % (bound 5 %)."""
-    from fretsim.api import load_case, run
-    sets = ["model.dimension=2d", "model.slip=coulomb", "model.stroke=mid_stroke", "model.wear_law=energy",
-            "loading.friction_coefficient=0.9", "loading.stroke=1 um", "loading.cycles=200000",
-            "materials.moving.energy_wear_coefficient=2e5 um3/J", "materials.stationary.energy_wear_coefficient=3e6 um3/J",
-            "output.snapshots=auto", "grid.error_estimate=none"]
-    out = run(load_case(CASES / "mccoll_185N.yaml", sets))
-    ref = run(load_case(CASES / "mccoll_185N.yaml", [*sets, "jumping.tolerance=0.0005"]))
-    s = out.summary
-    actual = max(abs(s[k] - ref.summary[k]) / ref.summary[k] for k in ("max_wear_depth_moving_um",
-                                                                       "max_wear_depth_stationary_um"))
-    assert actual <= s["error_estimate_depth"] <= 0.05
-    assert s["contact_solves"] <= 500
+
+def test_near_the_transition_with_the_stroke_averaged_gap_forward_euler_steps_take_over_and_the_plan_warns():
+    """Ti-6Al-4V with k_m = k_s/10 (the stroke-averaged gap), μ 1.0, 8 µm (δ_t 6.9 µm), 989 elements, 4·10⁴ cycles
+    (a review's case): the run cycle by cycle ends the moving body at 0.47414 µm; BDF2 ended at 0.428 (9.7 % short,
+    estimated 1.8 %: its correction barely converges where the slip spreads 25-40 %); forward-Euler steps end at
+    0.465 (1.9 %).  The reference here is forward Euler at steps of at most 20 cycles (0.4726: 0.3 % from the run
+    cycle by cycle), the bound 3 % (measured 1.6 %; BDF2 9.4 %).  Their estimate is still no bound (0.2 %), which
+    the plan says."""
+    from fretsim.api import check, load_case, run
+    sets = ["materials.moving.wear_coefficient=2.75e-9 1/MPa", "materials.stationary.fatigue=null",
+            "loading.friction_coefficient=1.0", "loading.stroke=8 um", "loading.cycles=40000",
+            "grid.domain=[1.292 mm]", "grid.elements=[989]", "grid.error_estimate=none"]
+    out = run(load_case(CASES / "ti_fretting_fatigue.yaml", sets))
+    ref = run(load_case(CASES / "ti_fretting_fatigue.yaml", [*sets, "jumping.max=20"]))
+    key = "max_wear_depth_moving_um"
+    assert abs(out.summary[key] / ref.summary[key] - 1) < 0.03
+    assert any(w.startswith("near the gross-slip transition") for w in out.plan.warnings)
+    # not for the paper's mid-stroke gap (equal wear), where the implicit steps held
+    equal = check(load_case(CASES / "ti_fretting_fatigue.yaml", [*sets[1:]]))[2]
+    assert not any(w.startswith("near the gross-slip transition") for w in equal.warnings)

@@ -533,6 +533,7 @@ def test_an_automatic_grid_whose_stick_edge_checkerboards_is_refined_and_run_aga
     assert out.status == "complete", out.message
     note = next(n for n in out.notes if n.startswith("the automatic grid was refined"))
     assert "from 185 to 371 elements" in note and "checkerboarded at cycle 15,330" in note
+    assert "solves are not in contact_solves" in note
     r = read_results(tmp_path / "auto.h5")
     assert r.x.size == 371 and not r.regrids and r.history["cycle"][0] == 0 and r.history["cycle"][-1] == 40000
     choice = next(c for c in out.plan.choices if c.key == "grid.elements")
@@ -557,16 +558,26 @@ def test_a_run_interrupted_after_its_grid_was_refined_resumes_on_the_refined_gri
     a, b = read_results(tmp_path / "whole.h5"), read_results(tmp_path / "cut.h5")
     assert np.array_equal(a.fields["wear_depth_stationary"], b.fields["wear_depth_stationary"])
     assert np.array_equal(a.history["cycle"], b.history["cycle"]) and b.choices == a.choices
+    # interrupted in the first attempt, before the checkerboard: resuming refines as the whole run did (a review
+    # found the resume failing at cycle 15 262 instead, its file left 'failed' on 185 elements)
+    with pytest.raises(KeyboardInterrupt):
+        run(load_case(TI, [*UNEQUAL, "grid.error_estimate=none"]), tmp_path / "early.h5", observers=(_CtrlC(185),))
+    early = read_results(tmp_path / "early.h5")
+    assert early.status == "interrupted" and early.x.size == 185
+    assert resume(tmp_path / "early.h5").status == "complete"
+    c = read_results(tmp_path / "early.h5")
+    assert np.array_equal(a.fields["wear_depth_stationary"], c.fields["wear_depth_stationary"])
+    assert c.choices == a.choices and c.status == "complete"
 
 
 class _CtrlC:
-    """Ctrl-C at the refined run's 40th step (its steps start again from cycle 0)."""
+    """Ctrl-C at the 40th step on a grid of ``elements`` (the refined run's steps start again from cycle 0)."""
 
-    def __init__(self):
-        self.restarted, self.count = False, 0
+    def __init__(self, elements: int = 371):
+        self.elements, self.count = elements, 0
 
     def on_step(self, setup, step):
-        if setup.grid.shape[1] == 371:
+        if setup.grid.shape[1] == self.elements:
             self.count += 1
             if self.count == 40:
                 raise KeyboardInterrupt

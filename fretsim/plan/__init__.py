@@ -76,6 +76,7 @@ def prepare(case: Case, allow_unstable: bool = False, runs: Optional[SideRuns] =
                              "`fretsim check` includes it in its time estimate")
     cycles = cycle.build(case, plan, grids, operators, regime, proxy_case, runs, plan_case)
     steps = stepping.build(case, plan, grids, operators, cycles, allow_unstable)
+    stepping.warn_near_transition(case, plan, operators.gap_model, regime, steps.scheme)
     setup = _setup(case, plan, grids, operators, regime, cycles, steps, contact)
     if expected is not None:
         setup = dataclasses.replace(setup, expected_stop=float(expected))
