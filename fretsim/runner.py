@@ -20,8 +20,7 @@ import numpy as np
 from fretsim import grid_error, heap, regrid
 from fretsim.case import GEOMETRY_KEYS, Case, CaseError, parse_case
 from fretsim.errors import GridFeedback
-from fretsim.plan import Plan, SideRuns, estimate_cost, prepare, restore
-from fretsim.plan import _notes as plan_notes
+from fretsim.plan import Plan, SideRuns, estimate_cost, notes_of, prepare, restore
 from fretsim.plan.cycle import strip_compliances
 from fretsim.reference import effective_modulus
 from fretsim.results import (OutputBusy, OutputClaim, Results, ResultsIOError, ResultsWriter, check_output_path,
@@ -250,7 +249,7 @@ def _refined(outcome: Outcome, setup: Setup, filled: Case, plan: Plan, runs: Sid
     # the refined plan's warnings, of the refined grid (an unresolved stick zone's says which grid it means)
     warnings = [w.replace("(grid.elements is given)", "(the automatic grid, refined)") for w in new_plan.warnings]
     plan = dataclasses.replace(new_plan, choices=choices, warnings=warnings)
-    return dataclasses.replace(new_setup, notes=plan_notes(plan)), new_filled, plan, note
+    return dataclasses.replace(new_setup, notes=notes_of(plan)), new_filled, plan, note
 
 
 def _claim(path: Path) -> OutputClaim:

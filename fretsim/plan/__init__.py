@@ -35,8 +35,8 @@ from fretsim.simulate import Setup
 from fretsim.stepping.implicit import DEPTH_SHARE
 from fretsim.wear import wear_reach
 
-__all__ = ["Choice", "Plan", "SideRuns", "available_corrections", "estimate_cost", "estimate_solves", "prepare",
-           "restore", "show"]
+__all__ = ["Choice", "Plan", "SideRuns", "available_corrections", "estimate_cost", "estimate_solves", "notes_of",
+           "prepare", "restore", "show"]
 
 
 def prepare(case: Case, allow_unstable: bool = False, runs: Optional[SideRuns] = None, *,
@@ -100,7 +100,7 @@ def _setup(case: Case, plan: Plan, grids, operators, regime, cycles, steps, cont
                  coarse_gap=operators.coarse_gap, per_cycle=steps.per_cycle,
                  gross_slip_stroke=regime.transition if regime.transition is not None else float("nan"),
                  regime_block=regime.block if regime.transition is not None else None,
-                 notes=_notes(plan), planned_extent=grids.sizing.final_extent,
+                 notes=notes_of(plan), planned_extent=grids.sizing.final_extent,
                  **_fatigue(case, grids.grid, steps.snapshots, contact))
 
 
@@ -159,7 +159,7 @@ def _check_half_space(case: Case, half_width: float) -> None:
         raise CaseError(case.source, [("materials.moving.fatigue", problem)])
 
 
-def _notes(plan: Plan) -> tuple:
+def notes_of(plan: Plan) -> tuple:
     """The results file's notes: each automatic choice with its reason, then the plan's warnings."""
     return tuple(f"{c.key} = {show(c.value)}: {c.reason}" for c in plan.choices if not c.given) + tuple(plan.warnings)
 
@@ -182,7 +182,7 @@ def restore(setup: Setup, plan: Plan, provenance: list, notes: str = "") -> tupl
             c = dataclasses.replace(c, value=value if given else c.value, reason=reason, given=bool(given), error=error)
         choices.append(c)
     plan = dataclasses.replace(plan, choices=choices)
-    return dataclasses.replace(setup, notes=tuple(notes.split("\n")) if notes else _notes(plan)), plan
+    return dataclasses.replace(setup, notes=tuple(notes.split("\n")) if notes else notes_of(plan)), plan
 
 
 def _filled(case: Case, grids, operators, cycles, steps) -> Case:
