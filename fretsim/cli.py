@@ -310,13 +310,21 @@ def _interrupted(output, before: Optional[tuple], resuming: bool) -> None:
     (interrupted while planning, e.g. in auto's proxy runs: an earlier file of that name is as it was), or its
     accepted steps kept for --resume."""
     written = _file_id(output) != before
-    if written and _status_of(output) == "complete":  # the interrupt came after the last write
+    status = _status_of(output) if written else None
+    if status == "complete":  # the interrupt came after the last write
         click.echo(f"interrupted after the run had completed: {output} holds the whole run (status 'complete')")
         return
     if not written and not resuming:
         kept = f"; {output} is as it was before this run" if before is not None else ""
         raise Fail(f"interrupted before the run's first step was written (while planning or in its first solve): "
                    f"nothing was written{kept}; run the case again", EXIT_INTERRUPTED) from None
+    if written and _file_id(output) is None:  # a refinement removed a failed attempt's file (fretsim.runner)
+        raise Fail(f"interrupted before the run's first step on its refined grid was written: nothing of it is on "
+                   f"disk{' (the earlier ' + str(output) + ' was replaced)' if before is not None else ''}; run the "
+                   f"case again", EXIT_INTERRUPTED) from None
+    if status not in (None, "interrupted", "running"):  # e.g. an attempt that failed before its grid was refined
+        raise Fail(f"interrupted; {output} holds an attempt that ended {status!r}, which cannot be resumed: run the "
+                   f"case again with --overwrite", EXIT_INTERRUPTED) from None
     raise Fail(f"interrupted; every accepted step so far is in {output} (status 'interrupted'); continue with "
                f"`fretsim run --resume {output}`", EXIT_INTERRUPTED) from None
 

@@ -117,13 +117,24 @@ def grid_estimates(fine: dict, coarse: dict, p_fine: np.ndarray, grid_fine, p_co
     return out
 
 
-def diverging_note(fine: float, coarse: float, coarsest: Optional[float]) -> str:
-    seen = f"{coarsest:.4g}, {coarse:.4g}, {fine:.4g} MPa on grids 4×, 2× and 1×" if coarsest is not None else (
-        f"{coarse:.4g}, {fine:.4g} MPa on grids 2× and 1×")
+COARSE_GRIDS = ("4×", "2×", "1×")  # the grids of the companions' reading, in elements of the run's
+FINE_GRIDS = ("1×", "½×")  # ... of a companion twice as fine's
+
+
+def _seen(values, grids) -> str:
+    """'a, b, c MPa on grids 4×, 2× and 1×' of the finite values (unit-less for a sum)."""
+    pairs = [(v, g) for v, g in zip(values, grids) if v is not None and math.isfinite(v)]
+    return (f"{', '.join(f'{v:.4g}' for v, _ in pairs)} on grids {', '.join(g for _, g in pairs[:-1])} and "
+            f"{pairs[-1][1]}" if len(pairs) > 1 else "")
+
+
+def diverging_note(values: tuple, grids: tuple = COARSE_GRIDS) -> str:
+    """The note of a partial slip's peak pressure left unestimated: ``values`` (MPa) on ``grids`` (in elements of the
+    run's), coarsest first."""
     return (f"the peak pressure is not estimated (NaN): in partial slip it sits at the worn stick zone's edge, where "
-            f"refinement moves it with no limit a few grids can show ({seen} this run's element; an elastic "
-            f"singularity there, where the real material yields): the reported peak is this grid's, not a bound; the "
-            f"pressure field's estimate stands")
+            f"refinement moves it with no limit a few grids can show ({_seen(values, grids)} MPa this run's element; "
+            f"an elastic singularity there, where the real material yields): the reported peak is this grid's, not a "
+            f"bound; the pressure field's estimate stands")
 
 
 # A companion twice as fine, where the one twice as coarse stopped: the run's error e, with e − e/2^p = the
@@ -147,8 +158,9 @@ def finer_estimates(run: dict, fine: dict, p_run: np.ndarray, grid_run, p_fine: 
     norm = float(np.linalg.norm(pr))
     pressure = FINER_FACTOR * float(np.linalg.norm(np.atleast_2d(p_fine) - pr)) / norm if norm else 0.0
     peak = FINER_PEAK * _relative(run["max_pressure_MPa"], fine["max_pressure_MPa"])
-    out = dict(zip(KEYS, (depth, width, pressure, max(peak, pressure))))
-    out["peak_converging"], out["peak_diverging"] = False, False
+    unknown = stick_edge_peaks(run)  # (as grid_estimates: a partial slip's peak is not estimated)
+    out = dict(zip(KEYS, (depth, width, pressure, math.nan if unknown else max(peak, pressure))))
+    out["peak_converging"], out["peak_diverging"] = False, unknown
     return out
 
 
@@ -246,7 +258,7 @@ def fatigue_estimates(fine: dict, coarse: dict, factor: float = 1.0, coarsest: O
     out = {"estimated_error_cycles_to_crack": (factor * abs(crack - crack_c) / crack + fine["error_estimate_depth"]
                                                + states)
            if math.isfinite(crack) and math.isfinite(crack_c) and crack > 0 else math.nan}
-    diverging = fatigue_diverging(fine, coarse, coarsest)
+    diverging = fatigue_diverging(fine, coarse)
     grid = {}
     for key, _ in FATIGUE_PEAKS:
         v, v_c = fine.get(key, math.nan), coarse.get(key, math.nan)
@@ -262,24 +274,25 @@ def fatigue_estimates(fine: dict, coarse: dict, factor: float = 1.0, coarsest: O
     return out
 
 
-def fatigue_diverging(fine: dict, coarse: dict, coarsest: Optional[dict]) -> dict:
-    """{key: (coarsest, coarse, fine)} of the fatigue figures left unestimated: in partial slip (:func:`stick_edge_peaks`),
-    the SWT's peak and Miner's sum at the end (Ti-6Al-4V at 5 µm: the SWT peak 64.8, 137, 283 MPa on grids 1×, 2×
-    and 4× finer; Miner's sum 165, 223, 288)."""
-    if not stick_edge_peaks(fine):
+def fatigue_diverging(run: dict, *others: Optional[dict]) -> dict:
+    """{key: its values, the grids' in the order given} of the fatigue figures left unestimated: in partial slip
+    (:func:`stick_edge_peaks`), the SWT's peak and Miner's sum at the end (Ti-6Al-4V at 5 µm: the SWT peak 64.8,
+    137, 283 MPa on grids 1×, 2× and 4× finer; Miner's sum 165, 223, 288).  ``others``: the companions' summaries
+    (None: not run), their values listed in the order given, then ``run``'s (as COARSE_GRIDS)."""
+    if not stick_edge_peaks(run):
         return {}
-    values = {key: (coarsest.get(key, math.nan) if coarsest is not None else math.nan, coarse.get(key, math.nan),
-                    fine.get(key, math.nan)) for key, _ in FATIGUE_PEAKS}
-    return {key: v for key, v in values.items() if math.isfinite(v[2])}
+    values = {key: tuple(o.get(key, math.nan) if o is not None else math.nan for o in others) + (run.get(key, math.nan),)
+              for key, _ in FATIGUE_PEAKS}
+    return {key: v for key, v in values.items() if math.isfinite(v[-1])}
 
 
-def fatigue_diverging_note(diverging: dict) -> list:
+def fatigue_diverging_note(diverging: dict, grids: tuple = COARSE_GRIDS) -> list:
     if not diverging:
         return []
     names = dict(FATIGUE_PEAKS)
-    seen = "; ".join(f"{names[k]} {a:.4g}, {b:.4g}, {c:.4g}" for k, (a, b, c) in diverging.items())
+    seen = "; ".join(f"{names[k]} {_seen(v, grids)}" for k, v in diverging.items())
     return [f"{' and '.join(names[k] for k in diverging)} {'are' if len(diverging) > 1 else 'is'} not estimated "
             f"(NaN): in partial slip they are point values at the worn stick zone's edge, where the elastic field is "
-            f"singular (and passes yield) and refinement moves them with no limit a few grids can show ({seen} on "
-            f"grids 4×, 2× and 1× this run's element): reported as this grid's; the crack cycle, set before the wear "
-            f"concentrates the pressure there, keeps its estimate"]
+            f"singular (and passes yield) and refinement moves them with no limit a few grids can show ({seen}, in "
+            f"this run's elements): reported as this grid's; the crack cycle, set before the wear concentrates the "
+            f"pressure there, keeps its estimate"]

@@ -186,44 +186,60 @@ def _refining(outcome: Outcome, planned: tuple, output, overwrite: bool, fingerp
               runs: SideRuns, done: int) -> Outcome:
     """The run again from its start on a finer automatic grid while it fails with a GridFeedback (:func:`_refined`),
     ``done`` refinements made before (a resumed run's); the last attempt's outcome.  The failed attempt's results
-    file is removed first: a kill before the next attempt's first write then leaves no file (the CLI says nothing
-    was written, and the case runs again), never a 'failed' one that the next attempt was about to replace."""
+    file is removed before anything else (planning the finer grid included): a kill before the next attempt's first
+    write then leaves no file (the CLI says nothing was written, and the case runs again), never a 'failed' one that
+    the next attempt was about to replace.  A Ctrl-C or SIGTERM that came while the failed attempt was written (its
+    signals deferred, :func:`_ignore_signals`) stops the run there.  The refinements' notes go into each attempt's
+    plan notes, so its file says them from its first write (and a resume keeps them)."""
     setup, filled, plan = planned
-    notes: list = []
-    while True:
-        again = _refined(outcome, setup, filled, plan, runs, done + len(notes))
+    notes = [n for n in setup.notes if n.startswith(REFINED)]  # (a resumed run's earlier ones)
+    made = done
+    while _refinable(outcome, setup, plan, made):
+        _stop_if_deferred()
+        if output is not None and outcome.written:
+            Path(output).unlink(missing_ok=True)
+            outcome.written = False
+        again = _refined(outcome, setup, filled, plan, runs)
         if again is None:
-            if notes and outcome.status == "failed":
-                outcome.message += f" (on the automatic grid refined {len(notes)}× already: its notes)"
-            return outcome
+            break
+        made += 1
         setup, filled, plan, note = again
         notes.append(f"{note}; the discarded attempt's {outcome.summary.get('contact_solves', 0)} solves are not in "
                      f"contact_solves")
-        overwrite = overwrite or outcome.written  # (the file is this run's own now: the next attempt replaces it)
-        if output is not None and outcome.written:
-            Path(output).unlink(missing_ok=True)
-        sink = _Sink(output, setup, filled, plan, overwrite, None, fingerprint)
+        setup = dataclasses.replace(setup, notes=tuple(setup.notes) + tuple(notes))
+        sink = _Sink(output, setup, filled, plan, True, None, fingerprint)  # (the file is gone or this run's own)
         runs.say(note)  # (the owner's bar for the first attempt stops here; the next attempt gets one of its own)
         with runs._progress(setup) as bar:
-            outcome = _execute(setup, filled, plan, sink, bar or progress, observers, None, runs, tuple(notes))
+            outcome = _execute(setup, filled, plan, sink, bar or progress, observers, None, runs)
+    if made > done and outcome.status == "failed":
+        outcome.message += f" (on the automatic grid refined {made}× already: its notes)"
+    return outcome
+
+
+REFINED = "the automatic grid was refined from"
 
 
 def _refinements_made(plan: Plan) -> int:
     """How many times a resumed run's automatic grid was refined already (its grid.elements choice says)."""
-    return sum(c.reason.count("the automatic grid was refined from") for c in plan.choices if c.key == "grid.elements")
+    return sum(c.reason.count(REFINED) for c in plan.choices if c.key == "grid.elements")
 
 
 MAX_REFINEMENTS = (2, 1)  # an automatic grid refined 2× per time for a GridFeedback: in 2D, in 3D (4× the elements)
 
 
-def _refined(outcome: Outcome, setup: Setup, filled: Case, plan: Plan, runs: SideRuns, done: int):
-    """Where a run on an automatic grid failed with an odd-even pattern its cycle model grew on that grid (a
-    :class:`~fretsim.errors.GridFeedback`: a partial slip's stick edge on too coarse a grid), the case on a grid
-    twice as fine along x (and y for a point contact), to run again from the start: (setup, filled case, plan with
-    the refined choice, the note that says so); None otherwise, or after MAX_REFINEMENTS."""
+def _refinable(outcome: Outcome, setup: Setup, plan: Plan, done: int) -> bool:
+    """Whether a run on an automatic grid failed with an odd-even pattern its cycle model grew on that grid (a
+    :class:`~fretsim.errors.GridFeedback`: a partial slip's stick edge on too coarse a grid), ``done`` refinements
+    short of MAX_REFINEMENTS."""
+    return (isinstance(outcome.failure, GridFeedback) and regrid.grid_is_automatic(plan)
+            and done < MAX_REFINEMENTS[not setup.grid.plane_strain])
+
+
+def _refined(outcome: Outcome, setup: Setup, filled: Case, plan: Plan, runs: SideRuns):
+    """The case of a :func:`_refinable` failure on a grid twice as fine along x (and y for a point contact), to run
+    again from the start: (setup, filled case, plan with the refined choice, the note that says so); None where the
+    planner refuses it."""
     exc, plane = outcome.failure, setup.grid.plane_strain
-    if not isinstance(exc, GridFeedback) or not regrid.grid_is_automatic(plan) or done >= MAX_REFINEMENTS[not plane]:
-        return None
     line_contact = setup.y_edges_free and not plane
     e = filled.elements  # (a Coulomb cycle refuses refinement's coarse grid: grid.coarse_element is None here)
     elements = (grid_error.odd(2 * e[0]),) + (() if len(e) == 1 else (e[1],) if line_contact else
@@ -643,11 +659,25 @@ def _yield_note(filled: Case, summary: dict, counter: "_Counter") -> None:
                                  f"elastic model's)")
 
 
+_DEFERRED: list = []  # signals that came while ignored (_ignore_signals): a refinement's next attempt stops for them
+
+
 def _ignore_signals() -> dict:
-    """Ignore SIGINT and SIGTERM (main thread only); returns the handlers to restore."""
+    """Hold off SIGINT and SIGTERM (main thread only), noting any that come (:func:`_stop_if_deferred`); returns the
+    handlers to restore."""
     if threading.current_thread() is not threading.main_thread():
         return {}
-    return {sig: signal.signal(sig, signal.SIG_IGN) for sig in (signal.SIGINT, signal.SIGTERM)}
+    _DEFERRED.clear()
+    return {sig: signal.signal(sig, lambda signum, frame: _DEFERRED.append(signum))
+            for sig in (signal.SIGINT, signal.SIGTERM)}
+
+
+def _stop_if_deferred() -> None:
+    """A Ctrl-C (or SIGTERM) held off while a failed attempt's file was written: the run stops before the next
+    attempt, as it would have had the signal come a moment later."""
+    if _DEFERRED:
+        _DEFERRED.clear()
+        raise KeyboardInterrupt
 
 
 def _restore_signals(previous: dict) -> None:
@@ -707,18 +737,16 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
     out[grid_error.LIMIT_KEY] = grid_error.cycles_to_limit_estimate(summary, coarse, counter.last.limit, model_part)
     if setup.fatigue is not None:
         out.update(grid_error.fatigue_estimates(summary, coarse, coarsest=coarsest))
-        counter.notes.extend(grid_error.fatigue_diverging_note(grid_error.fatigue_diverging(summary, coarse, coarsest)))
+        unknown = grid_error.fatigue_diverging(summary, coarsest, coarse)
+        counter.notes.extend(grid_error.fatigue_diverging_note(unknown))
         counter.notes.extend(grid_error.fatigue_over(summary, coarse, out, filled.accuracy))
-        if math.isfinite(summary.get("fatigue_damage_moving", math.nan)):  # (the estimates are the flat's)
-            counter.notes.append("the moving body's fatigue figures (cycles_to_crack_initiation_moving, "
-                                 "swt_max_moving_MPa, fatigue_damage_moving) carry no error estimate: the "
-                                 "estimated_error_* of the fatigue are the flat's")
+        counter.notes.extend(_moving_fatigue_note(summary))
     if counter.last.limit is not None and not math.isfinite(out[grid_error.LIMIT_KEY]):
         counter.notes.append("the grid's part of cycles_to_limit was not estimated: the companion run on a grid "
                              "twice as coarse reached no limit within loading.cycles")
     if part["peak_diverging"]:
-        counter.notes.append(grid_error.diverging_note(summary["max_pressure_MPa"], coarse["max_pressure_MPa"],
-                                                       None if coarsest is None else coarsest["max_pressure_MPa"]))
+        counter.notes.append(grid_error.diverging_note((None if coarsest is None else coarsest["max_pressure_MPa"],
+                                                        coarse["max_pressure_MPa"], summary["max_pressure_MPa"])))
     elif not part["peak_converging"]:
         counter.notes.append(grid_error.peak_note(summary["max_pressure_MPa"], coarse["max_pressure_MPa"],
                                                   coarsest["max_pressure_MPa"], out["estimated_error_max_pressure"]))
@@ -762,8 +790,22 @@ def _finer_estimates(setup: Setup, filled: Case, counter: "_Counter", runs: Side
                                                                     grid_error.FINER_FACTOR)
     if setup.fatigue is not None:
         out.update(grid_error.fatigue_estimates(summary, fine, grid_error.FINER_FACTOR))
+        counter.notes.extend(grid_error.fatigue_diverging_note(grid_error.fatigue_diverging(summary, fine),
+                                                               grid_error.FINE_GRIDS[::-1]))
+        counter.notes.extend(_moving_fatigue_note(summary))
     counter.notes.append(grid_error.finer_note(stopped, f_setup.grid.shape[1], out, filled.accuracy))
+    if part["peak_diverging"]:
+        counter.notes.append(grid_error.diverging_note((summary["max_pressure_MPa"], fine["max_pressure_MPa"]),
+                                                       grid_error.FINE_GRIDS))
     return out
+
+
+def _moving_fatigue_note(summary: dict) -> list:
+    """The moving body's fatigue figures, where it has constants: not estimated (the estimates are the flat's)."""
+    if not math.isfinite(summary.get("fatigue_damage_moving", math.nan)):
+        return []
+    return ["the moving body's fatigue figures (cycles_to_crack_initiation_moving, swt_max_moving_MPa, "
+            "fatigue_damage_moving) carry no error estimate: the estimated_error_* of the fatigue are the flat's"]
 
 
 def estimate(setup: Setup, filled: Case, runs: Optional[SideRuns] = None) -> dict:

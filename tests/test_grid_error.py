@@ -241,8 +241,7 @@ def test_a_run_whose_coarser_companion_breaks_down_is_estimated_from_a_finer_one
     assert s["estimated_error_depth"] >= 1.2 * actual
     width = max(abs(s[k] - ref[k]) / s[k] for k in WIDTHS)
     assert s["estimated_error_width"] >= 1.2 * width
-    assert s["estimated_error_max_pressure"] >= abs(s["max_pressure_MPa"] - ref["max_pressure_MPa"]) / s[
-        "max_pressure_MPa"]
+    assert s["estimated_error_pressure"] > 0 and math.isnan(s["estimated_error_max_pressure"])  # (partial slip)
 
 
 def test_in_partial_slip_the_stick_edge_peaks_have_no_estimate_and_a_warning_says_why():
