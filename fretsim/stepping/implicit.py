@@ -80,6 +80,8 @@ class Implicit:
             # 0.09-0.15 at 0.36 δ_t and 0.16-0.35 at 0.91 δ_t on cases/ti_fretting_fatigue.yaml)
             headroom = max(1.0, 1.0 / (SLIP_STIFFNESS * 0.4 * setup.cycle.stroke / setup.gross_slip_stroke))
             steps += n / (setup.stability_limit / 2.0 * headroom)
+        elif _expects_near_transition(setup):  # the same steps in gross slip (near_transition): every point slides
+            steps += n / (setup.stability_limit / 2.0 * 4.0 / SLIP_STIFFNESS)  # nearly 4δ, the headroom 4/3
         return min(n + 1, int(steps))
 
     def max_jump(self, case, jump: int, limit: float, allow_unstable: bool) -> tuple[Optional[int], list]:
@@ -278,6 +280,16 @@ def _expects_stick(setup) -> bool:
     stroke = getattr(member, "stroke", None)
     return (_explicit_allowed(setup) and getattr(member, "needs_friction", False) and not getattr(member, "rigid", True)
             and stroke is not None and stroke < setup.gross_slip_stroke)
+
+
+def _expects_near_transition(setup) -> bool:
+    """Whether a run is expected to take near_transition's forward-Euler steps: a Coulomb cycle with the
+    stroke-averaged gap in gross slip below twice δ_t (the plan's warning's range)."""
+    member = setup.cycle
+    stroke = getattr(member, "stroke", None)
+    return (_explicit_allowed(setup) and getattr(member, "gap_model", "") == "stroke_average"
+            and getattr(member, "needs_friction", False) and not getattr(member, "rigid", True) and stroke is not None
+            and setup.gross_slip_stroke <= stroke < 2.0 * setup.gross_slip_stroke)
 
 
 def _slip_headroom(loop) -> float:
