@@ -460,6 +460,7 @@ def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from:
     setup, filled, plan = sink.setup, sink.filled, sink.plan  # (on the grid the run ended on)
     if counter.last is not None and setup.fatigue_specs:
         _yield_note(filled, _summary(setup, counter, t0), counter)
+        counter.notes.extend(_either_edge_notes(counter.last.state, _summary(setup, counter, t0)))
     if status == "complete" and counter.last is not None:
         _estimate_errors(setup, filled, plan, counter, sink, t0, runs)
     previous = _ignore_signals()  # a Ctrl-C in the last instant must not make a complete run look interrupted
@@ -660,6 +661,31 @@ def _yield_note(filled: Case, summary: dict, counter: "_Counter") -> None:
 
 
 _DEFERRED: list = []  # signals that came while ignored (_ignore_signals): a refinement's next attempt stops for them
+
+
+EITHER_EDGE = 0.99  # the two halves' largest damage this close: the crack could start at either edge
+
+
+def _either_edge_notes(state: dict, summary: dict) -> list:
+    """Where a body's crack could as well start at the other edge (a fully reversed cycle damages its two edges
+    alike): its largest Miner's sum on the side of x < 0 and on x > 0 within EITHER_EDGE of each other at the run's
+    end.  A review saw crack_location_x_mm change sign under refinement (−0.110, −0.114, +0.113 mm) while |x| held
+    within 4 µm."""
+    from fretsim.fatigue.damage import PREFIX
+    from fretsim.quantities import keyed
+    out = []
+    for body, prefix in PREFIX.items():
+        damage, x = state.get(f"{prefix}_damage"), summary.get(keyed("crack_location_x_mm", body), math.nan)
+        if damage is None or not math.isfinite(x):
+            continue
+        half = damage.shape[-1] // 2
+        left, right = float(damage[..., :half].max()), float(damage[..., -half:].max())
+        if half and min(left, right) >= EITHER_EDGE * max(left, right):
+            out.append(f"the {'flat' if body == 'stationary' else 'moving body'}'s crack could start at either edge "
+                       f"(x = ±{abs(x):.4g} mm): the largest Miner's sums on the two sides are within "
+                       f"{1 - min(left, right) / max(left, right):.2%} of each other, and crack_location_x_mm's sign "
+                       f"is the side that reached 1 first on this grid")
+    return out
 
 
 def _ignore_signals() -> dict:
