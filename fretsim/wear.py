@@ -117,6 +117,9 @@ def wear_rates(pressure: np.ndarray, dx: float, stroke: float, k_moving: float, 
 _SEEN = {"mid_stroke": lambda h_s, dx, stroke: h_s, "stroke_average": stroke_average}
 # how far the flat's wear reaches beyond the contact, in strokes: one, or two seen through the stroke average
 GAP_REACH = {"mid_stroke": 1, "stroke_average": 2, "resolved": 1}
+# whether the contact sees the flat's wear through its average over the stroke (the stepping near the transition
+# needs to know: fretsim.stepping.implicit.near_transition)
+AVERAGED = {"mid_stroke": False, "stroke_average": True, "resolved": False}
 
 
 def gap_wear(h_moving: np.ndarray, h_stationary: np.ndarray, dx: float, stroke: float, gap_model: str) -> np.ndarray:

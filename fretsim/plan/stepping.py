@@ -15,7 +15,9 @@ from fretsim.case import PRESET_LINEAR, Case, CaseError
 from fretsim.grid import Grid
 from fretsim.plan.choices import Choice, Plan
 from fretsim.stability import Spectrum, combined, default_linear_jump, wear_spectrum
+from fretsim.cycle import CYCLES
 from fretsim.stepping import DEFAULT_SCHEME, SCHEMES
+from fretsim.wear import AVERAGED
 
 MODEL_GROWTH = math.log(1e3)  # a forced unstable model may grow a seed at most 1000-fold over the run
 SHORT_RUN = 8  # runs of at most this many cycles are taken a cycle at a time: exact, and as cheap
@@ -58,7 +60,7 @@ def warn_near_transition(case: Case, plan: Plan, gap_model: str, regime, scheme:
     bound there (fretsim.stepping.implicit.near_transition; forward-Euler steps take over from BDF2 where the slip
     spreads, 5× nearer the run cycle by cycle, their estimate still ~10× short), which the run must say."""
     transition = regime.transition
-    if (gap_model != "stroke_average" or regime.slip.value != "coulomb" or transition is None
+    if (not AVERAGED.get(gap_model, False) or CYCLES[regime.slip.value].assumes_gross_slip or transition is None
             or not transition <= case.loading.peak_stroke < NEAR_TRANSITION * transition
             or not SCHEMES[scheme].implicit):
         return

@@ -31,6 +31,7 @@ from fretsim.errors import NumericalFailure
 from fretsim.jumping import OMEGA_MAX, THETA_LANDING, bdf2_coefficients, bdf2_local_error, next_step
 from fretsim.loop.checks import model_growth_cause
 from fretsim.stepping.linear import relative_change
+from fretsim.wear import AVERAGED
 
 MAX_RETRIES = 8  # a failed solve is retried with a smaller step this many times
 HISTORY_POINTS = 8  # states kept for BDF2 (partner, error estimate) and the predictor
@@ -265,7 +266,12 @@ def near_transition(model, memory: dict) -> bool:
     (0.428 against 0.474 µm) with an estimate of 1.8 % (3 and 6 corrections: 0.391, 0.440), forward Euler 1.9 %
     short (and 0.3 % at steps of 20 cycles), its estimate 0.2 %: better, still no bound, which the plan's warning
     says.  With the paper's mid-stroke gap and equal wear the implicit steps held there (the same review)."""
-    return memory.get("slip_spread", 0.0) > SPREAD_EXPLICIT and getattr(model, "gap_model", "") == "stroke_average"
+    return memory.get("slip_spread", 0.0) > SPREAD_EXPLICIT and _averaged(model)
+
+
+def _averaged(member) -> bool:
+    """Whether a cycle member's contact sees the flat's wear averaged over the stroke (fretsim.wear.AVERAGED)."""
+    return AVERAGED.get(getattr(member, "gap_model", ""), False)
 
 
 def _explicit_allowed(setup) -> bool:
@@ -287,7 +293,7 @@ def _expects_near_transition(setup) -> bool:
     stroke-averaged gap in gross slip below twice δ_t (the plan's warning's range)."""
     member = setup.cycle
     stroke = getattr(member, "stroke", None)
-    return (_explicit_allowed(setup) and getattr(member, "gap_model", "") == "stroke_average"
+    return (_explicit_allowed(setup) and _averaged(member)
             and getattr(member, "needs_friction", False) and not getattr(member, "rigid", True) and stroke is not None
             and setup.gross_slip_stroke <= stroke < 2.0 * setup.gross_slip_stroke)
 
