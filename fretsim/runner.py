@@ -441,10 +441,9 @@ def _io_outcome(exc, sink: "_Sink", setup, filled, plan, counter, t0) -> Outcome
 
 
 def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from: Optional[Results],
-             runs: SideRuns, notes: tuple = ()) -> Outcome:
+             runs: SideRuns) -> Outcome:
     counter = _Counter(len(resume_from.history["cycle"]) if resume_from is not None else 0,
                        _recorded_errors(resume_from) if resume_from is not None else (0.0, 0.0))
-    counter.notes.extend(notes)
     t0 = time.perf_counter()
     state = resume_from.checkpoint if resume_from is not None else None
     output = sink.output
@@ -459,8 +458,9 @@ def _execute(setup, filled, plan, sink: _Sink, progress, observers, resume_from:
         raise
     setup, filled, plan = sink.setup, sink.filled, sink.plan  # (on the grid the run ended on)
     if counter.last is not None and setup.fatigue_specs:
-        _yield_note(filled, _summary(setup, counter, t0), counter)
-        counter.notes.extend(_either_edge_notes(counter.last.state, _summary(setup, counter, t0)))
+        summary = _summary(setup, counter, t0)
+        _yield_note(filled, summary, counter)
+        counter.notes.extend(_either_edge_notes(counter.last.state, summary))
     if status == "complete" and counter.last is not None:
         _estimate_errors(setup, filled, plan, counter, sink, t0, runs)
     previous = _ignore_signals()  # a Ctrl-C in the last instant must not make a complete run look interrupted
@@ -660,9 +660,6 @@ def _yield_note(filled: Case, summary: dict, counter: "_Counter") -> None:
                                  f"elastic model's)")
 
 
-_DEFERRED: list = []  # signals that came while ignored (_ignore_signals): a refinement's next attempt stops for them
-
-
 EITHER_EDGE = 0.99  # the two halves' largest damage this close: the crack could start at either edge
 
 
@@ -686,6 +683,9 @@ def _either_edge_notes(state: dict, summary: dict) -> list:
                        f"{1 - min(left, right) / max(left, right):.2%} of each other, and crack_location_x_mm's sign "
                        f"is the side that reached 1 first on this grid")
     return out
+
+
+_DEFERRED: list = []  # signals that came while ignored (_ignore_signals): a refinement's next attempt stops for them
 
 
 def _ignore_signals() -> dict:
