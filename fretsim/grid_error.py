@@ -113,7 +113,7 @@ def grid_estimates(fine: dict, coarse: dict, p_fine: np.ndarray, grid_fine, p_co
     #  1670 N 2D read 233, 209, 217, 278, 279, 262 MPa from 4× coarser to 8× finer — and its reading stands)
     unknown = stick_edge_peaks(fine)
     out = dict(zip(KEYS, (depth, width, pressure, math.nan if unknown else max(peak, pressure))))
-    out["peak_converging"], out["peak_diverging"] = converging, unknown
+    out["peak_converging"], out["peak_unestimated"] = converging, unknown
     return out
 
 
@@ -128,7 +128,7 @@ def _seen(values, grids) -> str:
             f"{pairs[-1][1]}" if len(pairs) > 1 else "")
 
 
-def diverging_note(values: tuple, grids: tuple = COARSE_GRIDS) -> str:
+def stick_edge_note(values: tuple, grids: tuple = COARSE_GRIDS) -> str:
     """The note of a partial slip's peak pressure left unestimated: ``values`` (MPa) on ``grids`` (in elements of the
     run's), coarsest first."""
     return (f"the peak pressure is not estimated (NaN): in partial slip it sits at the worn stick zone's edge, where "
@@ -160,7 +160,7 @@ def finer_estimates(run: dict, fine: dict, p_run: np.ndarray, grid_run, p_fine: 
     peak = FINER_PEAK * _relative(run["max_pressure_MPa"], fine["max_pressure_MPa"])
     unknown = stick_edge_peaks(run)  # (as grid_estimates: a partial slip's peak is not estimated)
     out = dict(zip(KEYS, (depth, width, pressure, math.nan if unknown else max(peak, pressure))))
-    out["peak_converging"], out["peak_diverging"] = False, unknown
+    out["peak_converging"], out["peak_unestimated"] = False, unknown
     return out
 
 
@@ -246,7 +246,7 @@ def fatigue_estimates(fine: dict, coarse: dict, factor: float = 1.0, coarsest: O
     concentrates the pressure: within 2.5-3 % of grids 4× finer, estimated 3.4-6 %).  The SWT's peak and Miner's sum
     at the end are read as the peak pressure is (:func:`peak_estimate`: as if falling with √h, from the nearer
     difference where the three grids show them converging, the larger where not), and NaN in partial slip
-    (:func:`fatigue_diverging`): read as the plain difference, they were 15-25 % short where they converge
+    (:func:`fatigue_unestimated`): read as the plain difference, they were 15-25 % short where they converge
     (Ti-6Al-4V at 6 µm, in gross slip: the SWT 18 % below grids 8× finer, estimated 15.8 %) and a constant ~50 % in
     partial slip, where the SWT doubles with each halving of the element (a review's runs).
     ``factor``: FINER_FACTOR where the companion is twice as fine (those two then as FINER_PEAK times the
@@ -258,12 +258,12 @@ def fatigue_estimates(fine: dict, coarse: dict, factor: float = 1.0, coarsest: O
     out = {"estimated_error_cycles_to_crack": (factor * abs(crack - crack_c) / crack + fine["error_estimate_depth"]
                                                + states)
            if math.isfinite(crack) and math.isfinite(crack_c) and crack > 0 else math.nan}
-    diverging = fatigue_diverging(fine, coarse)
+    unestimated = fatigue_unestimated(fine, coarse)
     grid = {}
     for key, _ in FATIGUE_PEAKS:
         v, v_c = fine.get(key, math.nan), coarse.get(key, math.nan)
         v_cc = coarsest.get(key, math.nan) if coarsest is not None else math.nan
-        if not (math.isfinite(v) and math.isfinite(v_c) and v > 0) or key in diverging:
+        if not (math.isfinite(v) and math.isfinite(v_c) and v > 0) or key in unestimated:
             grid[key] = math.nan
         elif factor != 1.0:
             grid[key] = FINER_PEAK * _relative(v, v_c)
@@ -274,7 +274,7 @@ def fatigue_estimates(fine: dict, coarse: dict, factor: float = 1.0, coarsest: O
     return out
 
 
-def fatigue_diverging(run: dict, *others: Optional[dict]) -> dict:
+def fatigue_unestimated(run: dict, *others: Optional[dict]) -> dict:
     """{key: its values, the grids' in the order given} of the fatigue figures left unestimated: in partial slip
     (:func:`stick_edge_peaks`), the SWT's peak and Miner's sum at the end (Ti-6Al-4V at 5 µm: the SWT peak 64.8,
     137, 283 MPa on grids 1×, 2× and 4× finer; Miner's sum 165, 223, 288).  ``others``: the companions' summaries
@@ -286,12 +286,12 @@ def fatigue_diverging(run: dict, *others: Optional[dict]) -> dict:
     return {key: v for key, v in values.items() if math.isfinite(v[-1])}
 
 
-def fatigue_diverging_note(diverging: dict, grids: tuple = COARSE_GRIDS) -> list:
-    if not diverging:
+def fatigue_unestimated_note(unestimated: dict, grids: tuple = COARSE_GRIDS) -> list:
+    if not unestimated:
         return []
     names = dict(FATIGUE_PEAKS)
-    seen = "; ".join(f"{names[k]} {_seen(v, grids)}" for k, v in diverging.items())
-    return [f"{' and '.join(names[k] for k in diverging)} {'are' if len(diverging) > 1 else 'is'} not estimated "
+    seen = "; ".join(f"{names[k]} {_seen(v, grids)}" for k, v in unestimated.items())
+    return [f"{' and '.join(names[k] for k in unestimated)} {'are' if len(unestimated) > 1 else 'is'} not estimated "
             f"(NaN): in partial slip they are point values at the worn stick zone's edge, where the elastic field is "
             f"singular (and passes yield) and refinement moves them with no limit a few grids can show ({seen}, in "
             f"this run's elements): reported as this grid's; the crack cycle, set before the wear concentrates the "

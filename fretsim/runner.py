@@ -763,15 +763,15 @@ def _error_estimates(setup: Setup, filled: Case, plan: Plan, counter: "_Counter"
     out[grid_error.LIMIT_KEY] = grid_error.cycles_to_limit_estimate(summary, coarse, counter.last.limit, model_part)
     if setup.fatigue is not None:
         out.update(grid_error.fatigue_estimates(summary, coarse, coarsest=coarsest))
-        unknown = grid_error.fatigue_diverging(summary, coarsest, coarse)
-        counter.notes.extend(grid_error.fatigue_diverging_note(unknown))
+        unknown = grid_error.fatigue_unestimated(summary, coarsest, coarse)
+        counter.notes.extend(grid_error.fatigue_unestimated_note(unknown))
         counter.notes.extend(grid_error.fatigue_over(summary, coarse, out, filled.accuracy))
         counter.notes.extend(_moving_fatigue_note(summary))
     if counter.last.limit is not None and not math.isfinite(out[grid_error.LIMIT_KEY]):
         counter.notes.append("the grid's part of cycles_to_limit was not estimated: the companion run on a grid "
                              "twice as coarse reached no limit within loading.cycles")
-    if part["peak_diverging"]:
-        counter.notes.append(grid_error.diverging_note((None if coarsest is None else coarsest["max_pressure_MPa"],
+    if part["peak_unestimated"]:
+        counter.notes.append(grid_error.stick_edge_note((None if coarsest is None else coarsest["max_pressure_MPa"],
                                                         coarse["max_pressure_MPa"], summary["max_pressure_MPa"])))
     elif not part["peak_converging"]:
         counter.notes.append(grid_error.peak_note(summary["max_pressure_MPa"], coarse["max_pressure_MPa"],
@@ -816,12 +816,12 @@ def _finer_estimates(setup: Setup, filled: Case, counter: "_Counter", runs: Side
                                                                     grid_error.FINER_FACTOR)
     if setup.fatigue is not None:
         out.update(grid_error.fatigue_estimates(summary, fine, grid_error.FINER_FACTOR))
-        counter.notes.extend(grid_error.fatigue_diverging_note(grid_error.fatigue_diverging(summary, fine),
+        counter.notes.extend(grid_error.fatigue_unestimated_note(grid_error.fatigue_unestimated(summary, fine),
                                                                grid_error.FINE_GRIDS[::-1]))
         counter.notes.extend(_moving_fatigue_note(summary))
     counter.notes.append(grid_error.finer_note(stopped, f_setup.grid.shape[1], out, filled.accuracy))
-    if part["peak_diverging"]:
-        counter.notes.append(grid_error.diverging_note((summary["max_pressure_MPa"], fine["max_pressure_MPa"]),
+    if part["peak_unestimated"]:
+        counter.notes.append(grid_error.stick_edge_note((summary["max_pressure_MPa"], fine["max_pressure_MPa"]),
                                                        grid_error.FINE_GRIDS))
     return out
 

@@ -279,7 +279,7 @@ def test_the_fatigue_peaks_are_read_as_the_peak_pressure_is_and_not_at_all_where
     they converge slowly (Ti-6Al-4V at 6 µm, gross slip: the SWT 6.29 MPa, 18 % below grids 8× finer, estimated
     15.8 %); now as the peak pressure (√h over the nearer difference, 2.4× it), and NaN where in partial slip they
     are point values at the stick zone's edge."""
-    from fretsim.grid_error import SQRT_H, fatigue_diverging, fatigue_estimates
+    from fretsim.grid_error import SQRT_H, fatigue_unestimated, fatigue_estimates
     fine = {"swt_max_MPa": 100.0, "fatigue_damage": 2.0, "cycles_to_crack_initiation": 1000.0,
             "error_estimate_depth": 0.001, "fatigue_states_error": 0.002, "regime": "gross_slip"}
     coarse = {**fine, "swt_max_MPa": 90.0, "fatigue_damage": 1.9, "cycles_to_crack_initiation": 1050.0}
@@ -288,11 +288,11 @@ def test_the_fatigue_peaks_are_read_as_the_peak_pressure_is_and_not_at_all_where
     assert est["estimated_error_swt_max"] == pytest.approx(SQRT_H * 0.10)
     assert est["estimated_error_fatigue_damage"] == pytest.approx(SQRT_H * 0.05 + 0.001 + 0.002)
     assert est["estimated_error_cycles_to_crack"] == pytest.approx(0.05 + 0.001 + 0.002)
-    assert not fatigue_diverging(fine, coarse, coarsest)
+    assert not fatigue_unestimated(fine, coarse, coarsest)
     rising = {**coarsest, "swt_max_MPa": 85.0}  # 5 then 10: not converging, read from the larger difference
     assert fatigue_estimates(fine, coarse, coarsest=rising)["estimated_error_swt_max"] == pytest.approx(SQRT_H * 0.1)
     partial = {**fine, "regime": "partial_slip"}  # the stick zone's edge: not estimated, whatever the grids show
-    assert set(fatigue_diverging(partial, coarse, coarsest)) == {"swt_max_MPa", "fatigue_damage"}
+    assert set(fatigue_unestimated(partial, coarse, coarsest)) == {"swt_max_MPa", "fatigue_damage"}
     est = fatigue_estimates(partial, coarse, coarsest=coarsest)
     assert math.isnan(est["estimated_error_swt_max"]) and math.isnan(est["estimated_error_fatigue_damage"])
     assert est["estimated_error_cycles_to_crack"] == pytest.approx(0.05 + 0.001 + 0.002)
