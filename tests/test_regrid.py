@@ -477,7 +477,7 @@ def test_a_side_run_widens_its_automatic_grid_from_its_last_step_and_a_users_gri
         sized = pilot()
     finally:
         plan_grid.auto_grid = real
-    assert follows == pytest.approx(sized, rel=1e-3)  # the pilot's own tolerance is 0.03: it finds the stop roughly
+    assert follows == pytest.approx(sized, rel=1e-3)  # (its tolerance is PILOT_TOLERANCE: it finds the stop roughly)
     # a side run that may not widen stops at the edge
     setup, filled, plan = prepare(load_case(TUBE, ["limits.wall_loss=20 %", "grid.error_estimate=none"]))
     rule = regrid.rule_for(filled, setup, plan)
