@@ -850,19 +850,28 @@ def fit(case_file: Path, measured_file: Path, fit_keys: tuple, overrides: tuple,
         raise Fail(f"the fit stopped: {exc}", 3) from None
     if live:
         click.echo("", err=True)
+    for note in res.notes:
+        click.echo(f"note: {note}", err=True)
     for k, v0, v, lo, hi, kind in zip(res.keys, res.start, res.values, res.low, res.high, res.kinds):
         def short(x):
             return f"{x:.4g}" + ("" if kind == "number" else f" {INTERNAL[kind]}")
         ci = f"95 % CI [{short(lo)}, {short(hi)}]" if np.isfinite(lo) else "no CI"
         click.echo(f"{k} = {short(v)}  ({ci}; started at {short(v0)})")
-    click.echo(f"{res.runs} runs, {res.dof} degree(s) of freedom. "
-               + (res.message if res.dof <= 0 or not res.converged else ""))
+    said = res.message if res.converged and (res.dof <= 0 or "determine" in res.message) else ""
+    click.echo(f"{res.runs} runs, {res.dof} degree(s) of freedom. " + said)
     click.echo("residuals (model/measured − 1; a profile's against its deepest point):")
     for n, key, x, meas, mod, r in zip(measured.cycles, measured.keys, measured.x, measured.values, res.model,
                                        res.residuals):
         where = f" at x = {x:.4g} mm" if np.isfinite(x) else ""
         click.echo(f"  cycle {n:>10,}  {key}{where}: measured {shown(meas, key, measured)}, model "
                    f"{shown(mod, key, measured)}, {r:+.2%}")
+    for warning in res.warnings:
+        click.echo(f"warning: {warning}", err=True)
+    unwritten = f"; {output} was not written" if output else ""
+    if not res.converged:  # values at the edge of the search are not a fit: no fitted case, and a failing exit
+        raise Fail(f"the fit did not converge: {res.message}{unwritten}", 3)
+    if not res.determined:  # printed values the data would fit as well with others: not a fit either
+        raise Fail(f"the data do not determine {', '.join(res.undetermined)} (above){unwritten}", 3)
     if output is not None:
         tmp = output.with_name(f".{output.name}.part")
         try:

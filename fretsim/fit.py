@@ -42,7 +42,7 @@ DEFAULT_FIT = ("materials.moving.wear_coefficient", "materials.stationary.wear_c
 WEAR_KINDS = ("wear_coefficient", "energy_wear_coefficient")  # the values whose top of the search wears most
 PROFILES = {"wear_depth_moving": "moving", "wear_depth_stationary": "stationary"}
 FIT_TOLERANCE = 1e-3  # jumping.tolerance of the fit's runs, at most
-DIFF_STEP = 0.05  # the finite differences' step in ln(value)
+DIFF_STEP = 0.05  # the finite differences' step: 5 % of each value (ln 1.05 in its logarithm)
 RANGE = 1000.0  # a value is sought within this factor of the case's
 MAX_GROWTH = 6  # the fit's grid is widened at most this many times (each at least doubles the domain)
 GROWTH_MARGIN = 4.0  # a grown grid holds the wear of the trial that outgrew it with its coefficients this much larger
@@ -275,7 +275,7 @@ def _model(case: Case, measured: Measured) -> np.ndarray:
 def shown(value: float, key: str, measured: Measured) -> str:
     """A datum in the unit its column was written in, as the house prints units (a column in um reads µm)."""
     unit = measured.units.get(key)
-    kind = "length" if key in PROFILES else LIMITS_SCHEMA[key].kind
+    kind = "length" if key in PROFILES or key == "x" else LIMITS_SCHEMA[key].kind
     if kind == "fraction" or not unit:
         return f"{value:.5g}"
     return f"{value / parse_quantity(f'1 {unit}', kind):.5g} {shown_unit(unit)}"
@@ -309,6 +309,15 @@ class FitResult:
     message: str
     kinds: tuple = ()
     given: tuple = ()  # the overrides every run had (--set): the fitted case is the case with them
+    choices: tuple = ()  # the model every run had (model.dimension, corrections, slip, gap): the fitted case's too
+    warnings: tuple = ()  # what makes a printed value less than it looks (a value the data do not determine, ...)
+    undetermined: tuple = ()  # the keys the data do not determine (their interval beyond UNDETERMINED, or none)
+    notes: tuple = ()  # what the user should know of how the values were fitted (the model of the runs)
+
+    @property
+    def determined(self) -> bool:
+        """Every value fitted is determined by the data (no interval wider than UNDETERMINED either side)."""
+        return not self.undetermined
 
     @property
     def converged(self) -> bool:
@@ -365,6 +374,12 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
     if len(tops) == len(keys):  # a fitted load or stroke would wear beyond what the coefficients bound
         _check_scale(parse_case(case_text, source=source, overrides=[*base, *tops]), measured)
     grid = _Grid(case_text, source, base, case0)
+    notes = []
+    if case0.gap_model == "auto" and grid.filled.gap_model != STABLE_GAP:
+        notes.append(f"the fit's runs take the flat's wear through the stroke-averaged gap (model.gap {STABLE_GAP}), "
+                     f"stable for any coefficients the search may try; the case alone would choose "
+                     f"{grid.filled.gap_model} (0.3 % apart in the coefficients on McColl 185 N, a review's): the "
+                     f"fitted case says model.gap {STABLE_GAP}")
     runs = [0]
     cache: dict = {}
 
@@ -374,7 +389,7 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
             vals = np.exp(logs)
             sets = [f"{k}={_written(v, s.kind)}" for k, v, s in zip(keys, vals, specs)]
             try:
-                case = parse_case(case_text, source=source, overrides=[*base, *grid.choices, *sets])
+                case = _unlimited(parse_case(case_text, source=source, overrides=[*base, *grid.choices, *sets]))
                 cache[key] = _model(case, measured)
             except _Outgrown:
                 raise _Outgrown(logs) from None
@@ -392,11 +407,20 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
     low, high, dof, message = _intervals(sol, r, len(keys))
     at_bound = [k for k, x, a, b in zip(keys, sol.x, lo, hi) if min(x - a, b - x) < 1e-3]
     if at_bound:
-        message = (f"{', '.join(at_bound)} ended at the edge of the search ({RANGE:g}× from the start): the model "
-                   f"cannot reproduce the data with values in that range (see the residuals); the values are "
-                   f"not a fit" + (f"; {message}" if message else ""))
-    return FitResult(keys, start, np.exp(sol.x), low, high, r, cache[tuple(np.round(sol.x, 12))], measured, runs[0],
-                     dof, message or sol.message, tuple(s.kind for s in specs), tuple(overrides))
+        # a value the residuals hardly depend on drifts to the edge: the data do not determine it (a volume of the
+        # flat alone says nothing of the moving body's coefficient), which is not the model failing the data
+        size = np.linalg.norm(sol.jac, axis=0)
+        idle = [k for k, s in zip(keys, size) if k in at_bound and s <= INSENSITIVE * max(size.max(), 1e-300)]
+        why = (f"the data hardly depend on {', '.join(idle)}: they do not determine it (fit fewer values, or measure "
+               f"what it changes)" if idle else
+               f"the model cannot reproduce the data with values in that range (see the residuals)")
+        message = (f"{', '.join(at_bound)} ended at the edge of the search ({RANGE:g}× from the start): {why}; the "
+                   f"values are not a fit" + (f"; {message}" if message else ""))
+    values = np.exp(sol.x)
+    loose = _undetermined(keys, values, low, high, sol.jac)
+    return FitResult(keys, start, values, low, high, r, cache[tuple(np.round(sol.x, 12))], measured, runs[0],
+                     dof, message or sol.message, tuple(s.kind for s in specs), tuple(overrides), tuple(grid.model),
+                     tuple(_warnings(keys, start, values, at_bound, loose)), tuple(loose), tuple(notes))
 
 
 def _search(evaluate, x0, bounds, grid: "_Grid", keys, specs, note, cache: dict):
@@ -405,8 +429,8 @@ def _search(evaluate, x0, bounds, grid: "_Grid", keys, specs, note, cache: dict)
     from scipy.optimize import least_squares
     while True:
         try:
-            return least_squares(evaluate, x0, bounds=bounds, diff_step=DIFF_STEP, x_scale=1.0, xtol=1e-6, ftol=1e-8,
-                                 max_nfev=200)
+            return least_squares(evaluate, x0, jac=lambda x: _jacobian(evaluate, x, bounds), bounds=bounds,
+                                 x_scale=1.0, xtol=1e-6, ftol=1e-8, max_nfev=200)
         except _Outgrown as exc:
             trial = np.exp(exc.logs)
             tops = [_top(k, v * GROWTH_MARGIN, s) for k, v, s in zip(keys, trial, specs) if s.kind in WEAR_KINDS]
@@ -419,6 +443,69 @@ def _search(evaluate, x0, bounds, grid: "_Grid", keys, specs, note, cache: dict)
                 note(said)
             cache.clear()
             x0 = np.clip(exc.logs, *bounds)
+
+
+STABLE_GAP = "stroke_average"  # the gap model of a fit's runs unless the case names one (_Grid)
+PROFILE_REACH = 10.0  # a profile's x this many times beyond the widest scar the search can wear: a unit slip
+INSENSITIVE = 1e-3  # a value at the edge whose residuals' derivative is below this share of the largest: undetermined
+UNDETERMINED = 10.0  # a value whose 95 % interval reaches this factor either side is not determined by the data
+FAR = 100.0  # a value fitted this factor from its start: a unit slip in the measured file would do this
+
+
+def _undetermined(keys, values, low, high, jac) -> list[str]:
+    """The keys the data do not determine: an interval that spans more than UNDETERMINED either side (the data
+    would fit as well with another value), or, with no interval (a singular Jacobian), a derivative below
+    INSENSITIVE of the largest."""
+    size = np.linalg.norm(jac, axis=0)
+    out = []
+    for k, v, lo, hi, s in zip(keys, values, low, high, size):
+        if np.isfinite(lo) and np.isfinite(hi) and lo > 0:
+            if hi / v > UNDETERMINED or v / lo > UNDETERMINED:
+                out.append(k)
+        elif np.isfinite(lo) or s <= INSENSITIVE * max(size.max(), 1e-300):  # (an interval to 0 or inf: none)
+            out.append(k)
+    return out
+
+
+def _warnings(keys, start, values, at_bound, loose) -> list[str]:
+    """What the user must know before trusting a printed value: a value the data do not determine (its interval
+    spans more than UNDETERMINED either side: the data would fit as well with another), one fitted FAR from its
+    start (a depth written in mm under a µm header moved both coefficients about 225× in opposite directions and
+    fitted to 0.3 %)."""
+    out = []
+    if loose:
+        out.append(f"the data do not determine {', '.join(loose)}: other values fit them as well (a 95 % interval "
+                   f"wider than {UNDETERMINED:g}× either side, or none); measure a quantity that depends on "
+                   f"{'them' if len(loose) > 1 else 'it'} (each body's depth for its own coefficient), or fit fewer "
+                   f"values")
+    far = [f"{k} {v / s:.3g}×" for k, s, v in zip(keys, start, values) if k not in at_bound
+           and abs(math.log(v / s)) > math.log(FAR)]
+    if far:
+        out.append(f"fitted far from the start ({', '.join(far)} the starting value): if that is unexpected, check the "
+                   f"measured file's units (a depth in mm headed µm reads 1000× too small)")
+    return out
+
+
+def _jacobian(evaluate, x: np.ndarray, bounds: tuple) -> np.ndarray:
+    """The residuals' derivatives in ln(value), by forward differences of DIFF_STEP in each value (backward where
+    that would leave the search).  scipy's own ``diff_step`` is relative to x itself, here a logarithm (ln 2e-8 =
+    −17.7): its 5 % was a step of 0.89 in ln k, a factor of 2.4, and the confidence intervals from it 1.4× too
+    wide (a review's central differences of 1 %)."""
+    h = math.log1p(DIFF_STEP)
+    r0 = evaluate(x)
+    out = np.empty((r0.size, x.size))
+    for j in range(x.size):
+        step = h if x[j] + h <= bounds[1][j] else -h
+        moved = x.copy()
+        moved[j] += step
+        out[:, j] = (evaluate(moved) - r0) / step
+    return out
+
+
+def _unlimited(case: Case) -> Case:
+    """The case without its limits: a fit's run goes to the last measured cycle, where a trial that wears faster
+    than the measurements would stop at a wear limit before it (and planning a limited case runs a pilot)."""
+    return case.with_choices(limits=(), crack_limit=False) if case.limits or case.crack_limit else case
 
 
 def _top(key: str, value: float, spec: Key) -> str:
@@ -457,6 +544,13 @@ def _check_scale(top: Case, measured: Measured) -> None:
             "depth" if key in PROFILES or LIMITS_SCHEMA[key].kind == "length" else None)
         bound = {"volume": volume, "depth": 2 * volume / (math.pi * wx * wy),
                  "width": 2 * (SCAR_MARGIN * max(wx, a_max) + 2 * loading.peak_stroke)}.get(kind)
+        x = measured.x[i]
+        if key in PROFILES and "x" not in problems and abs(x) > PROFILE_REACH * (SCAR_MARGIN * max(wx, a_max)
+                                                                                 + 2 * loading.peak_stroke):
+            problems["x"] = (f"column x [{measured.units.get('x')}]",
+                             f"{shown(x, 'x', measured)} (row {measured.rows[i]}) is more than {PROFILE_REACH:g}× "
+                             f"as far from the centre as any run of the fit can wear by cycle {n:,}: is the column's "
+                             f"unit right? (an x in µm headed mm reads 1000× too far)")
         if key in problems or bound is None or not (v > bound or (kind == "width" and v < a_min / 10)):
             continue
         small = v <= bound
@@ -479,13 +573,13 @@ class _Grid:
 
     def __init__(self, case_text: str, source: str, base: list, case0: Case):
         from fretsim.plan import prepare
-        _, self.filled, _ = prepare(parse_case(case_text, source=source, overrides=base))
+        _, self.filled, _ = prepare(_unlimited(parse_case(case_text, source=source, overrides=base)))
         f = self.filled
         corrections = "none" if not f.corrections or f.corrections == "none" else list(f.corrections)
         self.model = [f"model.dimension={f.dimension}", f"model.corrections={corrections}", f"model.slip={f.slip}",
                       # the paper's mid-stroke gap is unstable where the moving body wears too little, which a search
                       # over the coefficients can reach: the stroke-averaged gap is stable for any (unless named)
-                      f"model.gap={case0.gap_model if case0.gap_model != 'auto' else 'stroke_average'}"]
+                      f"model.gap={case0.gap_model if case0.gap_model != 'auto' else STABLE_GAP}"]
         self.given = case0.domain is not None or case0.elements is not None  # a grid the case gives stays its own
         self.case_text, self.source, self.base = case_text, source, base
         self.domain, self.elements, self.grown = f.domain, f.elements, 0
@@ -550,7 +644,8 @@ def _intervals(sol, r: np.ndarray, p: int) -> tuple[np.ndarray, np.ndarray, int,
         try:
             cov = s2 * np.linalg.inv(jac.T @ jac)
             half = student.ppf(0.975, dof) * np.sqrt(np.clip(np.diag(cov), 0, None))
-            low, high = np.exp(sol.x - half), np.exp(sol.x + half)
+            with np.errstate(over="ignore", under="ignore"):  # an undetermined value's interval: 0 to inf, said so
+                low, high = np.exp(sol.x - half), np.exp(sol.x + half)
         except np.linalg.LinAlgError:
             pass
     message = ("" if dof > 0 else f"{m} measured value(s) for {p} fitted value(s): no degrees of freedom left, so no "
@@ -569,10 +664,12 @@ def fitted_case_text(case_text: str, result: FitResult) -> str:
     from fretsim.yamlread import loads
     raw = loads(case_text)
     problems: list = []
-    for item in [*result.given, *result.overrides()]:
+    for item in [*result.given, *result.choices, *result.overrides()]:
         _apply_override(raw, item, problems)
     header = "# fitted by fretsim fit to " + Path(result.measured.source).name + ": " + ", ".join(
         f"{k} = {_written(v, kind)}" for k, v, kind in zip(result.keys, result.values, result.kinds)) + "\n"
     if result.given:
         header += "# with the overrides it ran with: " + ", ".join(result.given) + "\n"
+    if result.choices:  # (the model planned at the starting values, the stroke-averaged gap unless the case named one)
+        header += "# and the model its runs used: " + ", ".join(result.choices) + "\n"
     return header + yaml.safe_dump(raw, sort_keys=False, allow_unicode=True)

@@ -72,13 +72,26 @@ PERCENTILES = (10, 50, 90)  # what a sampled sweep reports of each value (percen
 
 
 def quantiles(values) -> np.ndarray:
-    """P10, P50 and P90 of ``values`` (numbers, inf for a limit not reached): interpolated between the samples
-    where all are finite, else the sample at or above each fraction (an inf takes no part in an interpolation).
-    ``percentiles.csv`` and the time-to-limit figure both take them from here, so they agree."""
+    """P10, P50 and P90 of ``values`` (numbers, inf for a limit not reached), each sample at the middle of its share of
+    the probability (Hazen's (i + ½)/n, the middle of its Latin-hypercube stratum: fretsim.uncertainty) and
+    interpolated between them; where the upper of the two is inf (beyond the run) the lower, which the percentile is
+    at least (a time to a limit read short, not long), and inf where both are.  ``percentiles.csv`` and the time-to-
+    limit figure both take them from here, so they agree.  numpy's default plotting position i/(n − 1) puts the
+    extreme samples at 0 and 1 where their strata's middles are ½/n and 1 − ½/n: at n = 10 it read P10 and P90 of a
+    lognormal (factor 2) 14 % and 10 % towards the median, a band too narrow and a time-to-limit P10 too long (a
+    review's 300 seeds).  A percentile on a stratum's edge is now interpolated between the two samples that bracket
+    it, and errs outwards by the quantile function's curvature over one stratum (that P90 7 % high at n = 10, under
+    2 % at n = 60): a band a little too wide."""
     values = np.sort(np.asarray(values, dtype=float))
-    if np.isfinite(values).all():
-        return np.percentile(values, PERCENTILES, method="linear")
-    return np.array([np.quantile(values, q / 100, method="inverted_cdf") for q in PERCENTILES])
+    n = values.size
+    out = []
+    for q in PERCENTILES:
+        pos = min(max(q / 100 * n - 0.5, 0.0), n - 1.0)
+        lo = int(math.floor(pos))
+        hi, w = min(lo + 1, n - 1), pos - lo
+        a, b = values[lo], values[hi]
+        out.append(a if w == 0 or a == b or not np.isfinite(b) else a + w * (b - a))
+    return np.array(out, dtype=float)
 
 
 def through_origin(x, y) -> tuple[float, float]:

@@ -1,5 +1,6 @@
 """`fretsim fit` refuses what it cannot fit, each with its reason, and never hangs, overwrites its inputs or loses
 the settings it fitted under (issue 31, part three)."""
+import csv
 import os
 import re
 import subprocess
@@ -19,7 +20,9 @@ CASES = Path(__file__).resolve().parent.parent / "cases"
 CASE = CASES / "mccoll_185N.yaml"
 TWO_D = "model.dimension=2d"
 K_MOVING, K_STATIONARY = 3e-8, 1.2e-8  # the truth the synthetic measurements come from
-TRUTH = [TWO_D, f"materials.moving.wear_coefficient={K_MOVING} 1/MPa",
+# run with the model the fit's runs use (the stroke-averaged gap: fretsim.fit._Grid), so that the fit can recover
+# it: against the case's own mid-stroke gap the coefficients differ by 0.3 %, outside the intervals of noiseless data
+TRUTH = [TWO_D, "model.gap=stroke_average", f"materials.moving.wear_coefficient={K_MOVING} 1/MPa",
          f"materials.stationary.wear_coefficient={K_STATIONARY} 1/MPa", "output.snapshots=[3000, 9000, 18000]",
          "grid.error_estimate=none", "jumping.tolerance=1e-3"]
 DEPTHS = "cycle [cycles],max_wear_depth_moving [um],max_wear_depth_stationary [um]"
@@ -275,3 +278,66 @@ def test_fit_recovers_the_energy_laws_alpha_from_the_history_an_energy_run_expor
                       r"mm3/\(N\*mm\), (\S+) mm3/\(N\*mm\)\]", r.output)
     value, low, high = (float(v) * 1e3 for v in found.groups())  # mm³/(N·mm) → mm³/J
     assert value == pytest.approx(ALPHA_STATIONARY, rel=0.01) and low <= ALPHA_STATIONARY <= high, r.output
+
+
+# --- 7. what a review found (2026-11-28): limits, undetermined values, unit slips, the Jacobian's step -------------
+
+def test_a_fit_of_a_case_with_a_wear_limit_runs_every_trial_to_the_last_measured_cycle(truth):
+    """A trial that wears faster than the measurements stopped at the case's limit before the last measured cycle,
+    and the fit crashed (KeyError, a traceback): its runs now go without the limits, and find the truth."""
+    depths = (truth / "measured.csv").read_text().splitlines()
+    last = float(depths[-1].split(",")[2])
+    sets = [TWO_D, f"limits.max_wear_depth_stationary={last * 1.05} um",
+            f"materials.moving.wear_coefficient={K_MOVING * 1.5} 1/MPa",
+            f"materials.stationary.wear_coefficient={K_STATIONARY * 1.5} 1/MPa"]
+    res = fit(CASE.read_text(), str(CASE), read_measured(truth / "measured.csv"), overrides=sets)
+    assert res.converged and res.determined, res.message
+    assert res.values == pytest.approx([K_MOVING, K_STATIONARY], rel=0.01)
+
+
+def test_values_the_data_do_not_determine_fail_the_fit_and_write_no_case(truth, tmp_path):
+    """The flat's worn volume alone is k_s·P·4δ·N: it says nothing of k_m.  The fit printed k_m as if fitted (no
+    interval, the reason unsaid) and exited 0 with the fitted case written; now it names the value it cannot
+    determine and exits 3, writing nothing."""
+    rows = list(csv.DictReader((truth / "export" / "history.csv").open()))
+    volume = next(k for k in rows[0] if k.startswith("wear_volume_stationary"))
+    path = tmp_path / "v.csv"
+    path.write_text("cycle [cycles],wear_volume_stationary [mm3]\n" + "".join(
+        f"{r['cycle [cycles]']},{r[volume]}\n" for r in rows[1:] if float(r[volume]) > 0))
+    out = tmp_path / "fitted.yaml"
+    r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(path), "--set", TWO_D, "-o", str(out)])
+    assert r.exit_code == 3, r.output
+    assert "do not determine materials.moving.wear_coefficient" in r.output and "not written" in r.output
+    assert "Traceback" not in r.output and not out.exists()
+
+
+def test_a_profiles_x_in_micrometres_headed_mm_is_refused_naming_the_column(tmp_path):
+    """x written in µm under `x [mm]` put the profile ±300 mm wide on a 0.75 mm grid: each point beyond the grid
+    was compared with its edge and the fit ran (a review).  Refused, as the other unit slips are."""
+    path = tmp_path / "p.csv"
+    path.write_text("cycle [cycles],x [mm],wear_depth_stationary [um]\n" + "".join(
+        f"18000,{x},{max(0.0, 3 - abs(x) / 100)}\n" for x in range(-300, 301, 50)))
+    r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(path), "--set", TWO_D])
+    refused(r, "column x [mm]", "unit")
+
+
+def test_the_jacobian_steps_five_percent_in_each_value_not_five_percent_of_its_logarithm():
+    """scipy's diff_step is relative to x, here ln k ≈ −17.7: its 5 % was a step of 0.89 in ln k (a factor of 2.4)
+    and the intervals came out 1.4× too wide (a review's central differences).  The step is now ln 1.05, backward
+    at the top of the search; the derivative of exp(x) there is exp(x) within the step's first-order error."""
+    import math
+
+    import numpy as np
+
+    from fretsim.fit import DIFF_STEP, _jacobian
+    seen = []
+
+    def evaluate(x):
+        seen.append(np.array(x))
+        return np.exp(x)
+
+    x = np.log([2e-8, 3e-8])
+    jac = _jacobian(evaluate, x, (x - 5, np.array([x[0] + 5, x[1] + 0.01])))
+    steps = sorted({round(float(s[j] - x[j]), 12) for s in seen for j in range(2) if s[j] != x[j]})
+    assert steps == [round(-math.log1p(DIFF_STEP), 12), round(math.log1p(DIFF_STEP), 12)]
+    assert np.diag(jac) == pytest.approx(np.exp(x), rel=DIFF_STEP)
