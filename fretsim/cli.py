@@ -200,7 +200,7 @@ def _beyond_accuracy(note: str) -> bool:
     words), as opposed to how the estimates were made."""
     return ("exceeds model.accuracy" in note or "exceeds model.pressure_accuracy" in note
             or "too coarse for the numbers to have converged" in note or "is not estimated (NaN)" in note
-            or "are not estimated (NaN)" in note)
+            or "are not estimated (NaN)" in note or "not covered by its estimate" in note)
 
 
 HDF5_SIGNATURE = b"\x89HDF\r\n\x1a\n"
