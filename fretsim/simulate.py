@@ -73,6 +73,7 @@ class Setup:
     per_cycle: bool = True  # implicit schemes follow the per-cycle update (φ = h + ½r), not the continuous ODE
     gross_slip_stroke: float = float("nan")  # mm: δ_t of the unworn contact (NaN without a friction coefficient)
     regime_block: Optional[object] = None  # the block δ_t is of (the one nearest partial slip)
+    stick_cycles: int = 0  # cycles of the blocks in partial slip (unworn): what the stepping's estimate counts
     notes: tuple[str, ...] = ()
     planned_extent: float = 0.0  # mm along x: the grid that holds the final scar the plan expects (a grid that
     #                              follows the contact starts smaller and widens to it: fretsim.regrid.allowed)

@@ -100,6 +100,7 @@ def _setup(case: Case, plan: Plan, grids, operators, regime, cycles, steps, cont
                  coarse_gap=operators.coarse_gap, per_cycle=steps.per_cycle,
                  gross_slip_stroke=regime.transition if regime.transition is not None else float("nan"),
                  regime_block=regime.block if regime.transition is not None else None,
+                 stick_cycles=regime.stick_cycles,
                  notes=notes_of(plan), planned_extent=grids.sizing.final_extent,
                  **_fatigue(case, grids.grid, steps.snapshots, contact))
 

@@ -32,6 +32,7 @@ class Regime:
     transition: Optional[float]  # δ_t of the block nearest partial slip (mm; None without μ)
     block: Block  # the block nearest partial slip (the first without μ)
     slip: Choice
+    stick_cycles: int = 0  # the loading's cycles in blocks whose stroke is below their own δ_t (unworn)
 
 
 @dataclass(frozen=True)
@@ -106,16 +107,21 @@ def regime(case: Case, grid: Grid, compliance) -> Regime:
     nearest = blocks[0]
     if any(b.friction_coefficient is not None for b in blocks):
         tangential = tangential_operator(case, grid)
-        worst = None
+        worst, sticks = None, set()
         for b in dict.fromkeys(blocks):
             if b.friction_coefficient is None:
                 continue
             p_b = solve(compliance, case.geometry.separation(grid), grid_load(case, grid, b.normal_load),
                         tol=case.tolerance).pressure
             t_b = gross_slip_stroke(tangential, p_b, b.friction_coefficient)
+            if b.stroke < t_b:
+                sticks.add(b)
             if worst is None or t_b / b.stroke > worst[0]:
                 worst = (t_b / b.stroke, t_b, b)
         _, transition, nearest = worst
+        # (a history's partial-slip blocks take forward-Euler steps: what `check` counts of them)
+        stick = sum(b.cycles for b in blocks if b in sticks)
+        return Regime(tangential, transition, nearest, choose_slip(case, nearest, transition), stick)
     return Regime(tangential, transition, nearest, choose_slip(case, nearest, transition))
 
 
