@@ -420,7 +420,8 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
     loose = _undetermined(keys, values, low, high, sol.jac)
     return FitResult(keys, start, values, low, high, r, cache[tuple(np.round(sol.x, 12))], measured, runs[0],
                      dof, message or sol.message, tuple(s.kind for s in specs), tuple(overrides), tuple(grid.model),
-                     tuple(_warnings(keys, start, values, at_bound, loose)), tuple(loose), tuple(notes))
+                     tuple(_warnings(keys, start, values, at_bound, loose, r if dof <= 0 else None)), tuple(loose),
+                     tuple(notes))
 
 
 def _search(evaluate, x0, bounds, grid: "_Grid", keys, specs, note, cache: dict):
@@ -450,6 +451,7 @@ PROFILE_REACH = 10.0  # a profile's x this many times beyond the widest scar the
 INSENSITIVE = 1e-3  # a value at the edge whose residuals' derivative is below this share of the largest: undetermined
 UNDETERMINED = 10.0  # a value whose 95 % interval reaches this factor either side is not determined by the data
 FAR = 100.0  # a value fitted this factor from its start: a unit slip in the measured file would do this
+UNMATCHED = 1e-3  # a residual left by a fit with no degrees of freedom beyond this: the model cannot match the data
 
 
 def _undetermined(keys, values, low, high, jac) -> list[str]:
@@ -467,7 +469,7 @@ def _undetermined(keys, values, low, high, jac) -> list[str]:
     return out
 
 
-def _warnings(keys, start, values, at_bound, loose) -> list[str]:
+def _warnings(keys, start, values, at_bound, loose, exact=None) -> list[str]:
     """What the user must know before trusting a printed value: a value the data do not determine (its interval
     spans more than UNDETERMINED either side: the data would fit as well with another), one fitted FAR from its
     start (a depth written in mm under a µm header moved both coefficients about 225× in opposite directions and
@@ -483,6 +485,9 @@ def _warnings(keys, start, values, at_bound, loose) -> list[str]:
     if far:
         out.append(f"fitted far from the start ({', '.join(far)} the starting value): if that is unexpected, check the "
                    f"measured file's units (a depth in mm headed µm reads 1000× too small)")
+    if exact is not None and exact.size and np.abs(exact).max() > UNMATCHED:  # as many values as data, not matched
+        out.append(f"as many values fitted as measured, yet residuals of up to {np.abs(exact).max():.1%} remain: the "
+                   f"model cannot reproduce these data with any values in the search")
     return out
 
 

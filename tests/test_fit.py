@@ -341,3 +341,15 @@ def test_the_jacobian_steps_five_percent_in_each_value_not_five_percent_of_its_l
     steps = sorted({round(float(s[j] - x[j]), 12) for s in seen for j in range(2) if s[j] != x[j]})
     assert steps == [round(-math.log1p(DIFF_STEP), 12), round(math.log1p(DIFF_STEP), 12)]
     assert np.diag(jac) == pytest.approx(np.exp(x), rel=DIFF_STEP)
+
+
+def test_a_fit_with_no_degrees_of_freedom_that_leaves_residuals_says_the_model_cannot_match_them(truth, tmp_path):
+    """As many values as data, yet residuals remain (the flat's depth at 18 000 cycles 1.5× what grows from its depth
+    at 9 000 under any coefficients): the fit said only 'no CI' (a review, on the tube's ±5 %); it now warns that
+    the model cannot reproduce the data."""
+    rows = (truth / "measured.csv").read_text().splitlines()[2:]
+    (n1, _, d1), (n2, _, d2) = (r.split(",") for r in rows)
+    path = tmp_path / "m.csv"
+    path.write_text(f"cycle [cycles],max_wear_depth_stationary [um]\n{n1},{d1}\n{n2},{float(d2) * 1.5}\n")
+    r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(path), "--set", TWO_D])
+    assert "no degrees of freedom" in r.output and "model cannot reproduce these data" in r.output, r.output
