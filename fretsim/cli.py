@@ -822,7 +822,8 @@ def _not_an_input(output: Path, inputs: dict) -> None:
 def fit(case_file: Path, measured_file: Path, fit_keys: tuple, overrides: tuple, output: Path | None,
         debug: bool) -> None:
     """Fit case values (both wear coefficients by default) to measured wear by bounded least squares over runs
-    of CASE_FILE; print them with 95 % confidence intervals and the residuals."""
+    of CASE_FILE; print them with 95 % confidence intervals and the residuals.  Exit 3, and -o not written, where
+    there is no fit: a value at the edge of the search, or one the data do not determine."""
     import numpy as np
 
     from fretsim.fit import DEFAULT_FIT, fit as fit_case, fitted_case_text, read_measured, shown

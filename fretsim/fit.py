@@ -371,15 +371,11 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
                         "fit")
     _check_columns(case0, measured)
     tops = [_top(k, v * RANGE, s) for k, v, s in zip(keys, start, specs) if s.kind in WEAR_KINDS]
-    if len(tops) == len(keys):  # a fitted load or stroke would wear beyond what the coefficients bound
-        _check_scale(parse_case(case_text, source=source, overrides=[*base, *tops]), measured)
+    # (a fitted load or stroke would wear beyond what the coefficients bound: then only a profile's x is checked,
+    #  a factor PROFILE_REACH from the widest scar its coefficients' top wears)
+    _check_scale(parse_case(case_text, source=source, overrides=[*base, *tops]), measured, len(tops) == len(keys))
     grid = _Grid(case_text, source, base, case0)
-    notes = []
-    if case0.gap_model == "auto" and grid.filled.gap_model != STABLE_GAP:
-        notes.append(f"the fit's runs take the flat's wear through the stroke-averaged gap (model.gap {STABLE_GAP}), "
-                     f"stable for any coefficients the search may try; the case alone would choose "
-                     f"{grid.filled.gap_model} (0.3 % apart in the coefficients on McColl 185 N, a review's): the "
-                     f"fitted case says model.gap {STABLE_GAP}")
+    notes = _gap_notes(case0, grid.filled)
     runs = [0]
     cache: dict = {}
 
@@ -401,7 +397,7 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
         return _residuals(cache[key], measured)
 
     x0 = np.log(start)
-    lo, hi = x0 - math.log(RANGE), x0 + math.log(RANGE)
+    lo, hi = _bounds(x0, specs)
     sol = _search(evaluate, x0, (lo, hi), grid, keys, specs, note, cache)
     r = evaluate(sol.x)
     low, high, dof, message = _intervals(sol, r, len(keys))
@@ -414,10 +410,10 @@ def fit(case_text: str, source: str, measured: Measured, keys=DEFAULT_FIT, overr
         why = (f"the data hardly depend on {', '.join(idle)}: they do not determine it (fit fewer values, or measure "
                f"what it changes)" if idle else
                f"the model cannot reproduce the data with values in that range (see the residuals)")
-        message = (f"{', '.join(at_bound)} ended at the edge of the search ({RANGE:g}× from the start): {why}; the "
-                   f"values are not a fit" + (f"; {message}" if message else ""))
+        message = (f"{', '.join(at_bound)} ended at the edge of the search ({RANGE:g}× from the start, or the "
+                   f"value's own range): {why}; the values are not a fit" + (f"; {message}" if message else ""))
     values = np.exp(sol.x)
-    loose = _undetermined(keys, values, low, high, sol.jac)
+    loose = _undetermined(keys, values, low, high, sol.jac, dof)
     return FitResult(keys, start, values, low, high, r, cache[tuple(np.round(sol.x, 12))], measured, runs[0],
                      dof, message or sol.message, tuple(s.kind for s in specs), tuple(overrides), tuple(grid.model),
                      tuple(_warnings(keys, start, values, at_bound, loose, r if dof <= 0 else None)), tuple(loose),
@@ -454,17 +450,21 @@ FAR = 100.0  # a value fitted this factor from its start: a unit slip in the mea
 UNMATCHED = 1e-3  # a residual left by a fit with no degrees of freedom beyond this: the model cannot match the data
 
 
-def _undetermined(keys, values, low, high, jac) -> list[str]:
-    """The keys the data do not determine: an interval that spans more than UNDETERMINED either side (the data
-    would fit as well with another value), or, with no interval (a singular Jacobian), a derivative below
-    INSENSITIVE of the largest."""
+def _undetermined(keys, values, low, high, jac, dof: int) -> list[str]:
+    """The keys the data do not determine: all of them where there are fewer data than values (dof < 0: a
+    combination is fitted, no value alone) or the Jacobian's columns are dependent (its rank short: those whose
+    derivative is below INSENSITIVE of the largest, else all); an interval that spans more than UNDETERMINED either
+    side (the data would fit as well with another value); an interval to 0 or inf."""
     size = np.linalg.norm(jac, axis=0)
+    idle = [k for k, s in zip(keys, size) if s <= INSENSITIVE * max(size.max(), 1e-300)]
+    if dof < 0 or np.linalg.matrix_rank(jac) < len(keys):
+        return idle if idle and dof >= 0 else list(keys)
     out = []
-    for k, v, lo, hi, s in zip(keys, values, low, high, size):
-        if np.isfinite(lo) and np.isfinite(hi) and lo > 0:
-            if hi / v > UNDETERMINED or v / lo > UNDETERMINED:
-                out.append(k)
-        elif np.isfinite(lo) or s <= INSENSITIVE * max(size.max(), 1e-300):  # (an interval to 0 or inf: none)
+    for k, v, lo, hi in zip(keys, values, low, high):
+        bounded = bool(np.isfinite(lo) and np.isfinite(hi) and lo > 0)
+        if bounded and (hi / v > UNDETERMINED or v / lo > UNDETERMINED):
+            out.append(k)
+        elif not bounded and (np.isfinite(lo) or k in idle):  # an interval to 0 or inf; or none, and idle
             out.append(k)
     return out
 
@@ -480,7 +480,7 @@ def _warnings(keys, start, values, at_bound, loose, exact=None) -> list[str]:
                    f"wider than {UNDETERMINED:g}× either side, or none); measure a quantity that depends on "
                    f"{'them' if len(loose) > 1 else 'it'} (each body's depth for its own coefficient), or fit fewer "
                    f"values")
-    far = [f"{k} {v / s:.3g}×" for k, s, v in zip(keys, start, values) if k not in at_bound
+    far = [f"{k} {v / s:.3g}×" for k, s, v in zip(keys, start, values) if k not in at_bound and k not in loose
            and abs(math.log(v / s)) > math.log(FAR)]
     if far:
         out.append(f"fitted far from the start ({', '.join(far)} the starting value): if that is unexpected, check the "
@@ -489,6 +489,30 @@ def _warnings(keys, start, values, at_bound, loose, exact=None) -> list[str]:
         out.append(f"as many values fitted as measured, yet residuals of up to {np.abs(exact).max():.1%} remain: the "
                    f"model cannot reproduce these data with any values in the search")
     return out
+
+
+def _gap_notes(case0: Case, filled: Case) -> list[str]:
+    """The model the fit's runs use where it is not the one the case would choose: the stroke-averaged gap."""
+    if case0.gap_model != "auto" or filled.gap_model == STABLE_GAP:
+        return []
+    return [f"the fit's runs take the flat's wear through the stroke-averaged gap (model.gap {STABLE_GAP}), stable "
+            f"for any coefficients the search may try; the case alone would choose {filled.gap_model} (0.3 % apart in "
+            f"the coefficients on McColl 185 N, a review's): the fitted case says model.gap {STABLE_GAP}"]
+
+
+def _bounds(x0: np.ndarray, specs) -> tuple[np.ndarray, np.ndarray]:
+    """The search in ln(value): within RANGE of each start and within its key's own range and plausible range
+    (a friction coefficient searched to 1000× its start ran 6 minutes and stopped at μ = 18.3, out of [0, 10])."""
+    lo, hi = x0 - math.log(RANGE), x0 + math.log(RANGE)
+    for j, spec in enumerate(specs):
+        tops = [spec.hi] + ([spec.plausible[1]] if spec.plausible else [])
+        bottoms = [spec.lo] + ([spec.plausible[0]] if spec.plausible else [])
+        top, bottom = min(tops), max(bottoms)
+        if math.isfinite(top) and top > 0:
+            hi[j] = min(hi[j], math.log(top))
+        if math.isfinite(bottom) and bottom > 0:
+            lo[j] = max(lo[j], math.log(bottom))
+    return np.minimum(lo, x0 - 1e-9), np.maximum(hi, x0 + 1e-9)  # (the start itself always inside)
 
 
 def _jacobian(evaluate, x: np.ndarray, bounds: tuple) -> np.ndarray:
@@ -528,12 +552,14 @@ def _check_columns(case: Case, measured: Measured) -> None:
                                                                f"measure max_wear_depth_moving")], "measurements")
 
 
-def _check_scale(top: Case, measured: Measured) -> None:
+def _check_scale(top: Case, measured: Measured, values: bool = True) -> None:
     """Refuse a measured depth, width or volume that no run of the search can come near, a unit slip (mm for µm
     is a factor of 1000): ``top`` is the case at the top of the search.  Its worn volume (Archard's, both bodies)
     at each measured cycle, held in a scar of the geometry's shape (its own sizing estimate), bounds the depth
     from above (2V over the scar's area: 1.7× the cylinder's segment depth, the cap's own), and the width (the
-    scar and two strokes, as the grid is sized); no width is a tenth of the unworn contact's half-width a."""
+    scar and two strokes, as the grid is sized); no width is a tenth of the unworn contact's half-width a.  A
+    profile's x is refused PROFILE_REACH times beyond that scar; only x where ``values`` is False (a fitted value
+    besides the coefficients, whose top is not the search's)."""
     from fretsim.plan.choices import Plan
     from fretsim.plan.inputs import contact
     from fretsim.sizing import SCAR_MARGIN
@@ -556,7 +582,7 @@ def _check_scale(top: Case, measured: Measured) -> None:
                              f"{shown(x, 'x', measured)} (row {measured.rows[i]}) is more than {PROFILE_REACH:g}× "
                              f"as far from the centre as any run of the fit can wear by cycle {n:,}: is the column's "
                              f"unit right? (an x in µm headed mm reads 1000× too far)")
-        if key in problems or bound is None or not (v > bound or (kind == "width" and v < a_min / 10)):
+        if not values or key in problems or bound is None or not (v > bound or (kind == "width" and v < a_min / 10)):
             continue
         small = v <= bound
         where = (f"less than a tenth of the unworn contact's half-width a = {shown(a_min, key, measured)}" if small

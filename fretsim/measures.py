@@ -94,6 +94,19 @@ def quantiles(values) -> np.ndarray:
     return np.array(out, dtype=float)
 
 
+def column_quantiles(values: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """P10, P50 and P90 of each column of ``values`` (samples, points) as :func:`quantiles` reads them, its NaNs
+    (a sample that has stopped) left out; NaN where a column has none.  The uncertainty figure's depth band, so that
+    it reads its samples as ``percentiles.csv`` does."""
+    values = np.asarray(values, dtype=float)
+    out = np.full((len(PERCENTILES), values.shape[1]), np.nan)
+    for j in range(values.shape[1]):
+        column = values[:, j][~np.isnan(values[:, j])]
+        if column.size:
+            out[:, j] = quantiles(column)
+    return out[0], out[1], out[2]
+
+
 def through_origin(x, y) -> tuple[float, float]:
     """The slope of ``y`` against ``x`` by least squares through the origin, Σxy/Σx², and its scatter: the root
     mean square of y/(slope·x) − 1 over the points with x > 0 (0 for points exactly on the line).  Fouvry's

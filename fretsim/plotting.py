@@ -25,7 +25,7 @@ import matplotlib.pyplot as plt  # noqa: E402
 import numpy as np  # noqa: E402
 from matplotlib.ticker import FuncFormatter, MaxNLocator  # noqa: E402
 
-from fretsim.measures import centre_line, quantiles, through_origin  # noqa: E402
+from fretsim.measures import centre_line, column_quantiles, quantiles, through_origin  # noqa: E402
 from fretsim.quantities import SUMMARY, shown_unit  # noqa: E402
 from fretsim.results import Results, ResultsFileError, SweepTable  # noqa: E402
 
@@ -1557,7 +1557,7 @@ def band_data(table: SweepTable, key: str = "max_wear_depth_moving") -> dict:
         stopped = [bool(r.get("limit_reached")) for r in rows]
         values = np.array([np.interp(grid, c, v, right=v[-1] if held else np.nan)
                            for (c, v), held in zip(histories, stopped)])
-        p10, p50, p90 = (np.nanpercentile(values, q, axis=0) for q in (10, 50, 90))
+        p10, p50, p90 = column_quantiles(values)  # as percentiles.csv reads the samples
         out[group] = {"cycles": grid, "p10": p10, "p50": p50, "p90": p90, "points": len(histories)}
     return out
 

@@ -657,15 +657,18 @@ def _end_notes(setup: Setup, filled: Case, last: Step) -> list[str]:
     found = []
     for body, h in (("the moving body", last.wear_moving), ("the flat", last.wear_stationary)):
         rows = h.max(axis=1)
-        if rows.size >= 3 and rows.max() > 0 and int(np.argmax(rows)) in (0, rows.size - 1):
+        worn = np.flatnonzero(rows > 0)  # (a grid wider than the line: its end rows are the last worn ones)
+        if worn.size >= 3 and int(np.argmax(rows)) in (worn[0], worn[-1]):
             found.append(f"{body} ({rows.max() * 1e3:.4g} µm, {rows.max() / rows[rows.size // 2] - 1:.1%} over its "
                          f"centre line)")
     if not found:
         return []
+    rounded = ("; geometry type roller_on_flat models a real edge's rounding"
+               if filled.geometry.kind == "cylinder_on_flat" else "")
     return [f"the deepest wear of {' and of '.join(found)} is in an end row of the line contact, where a square "
-            f"end's pressure is singular: it grows as grid.elements refines the rows (McColl 185 N: 0.4-0.6 % a "
-            f"doubling), which is not covered by its estimate (the companions keep the rows); the centre-line depths "
-            f"converge, and geometry type roller_on_flat models a real edge's rounding"]
+            f"end's pressure is singular: it grows as grid.elements refines the rows (McColl 185 N in gross slip: "
+            f"0.4-0.6 % a doubling of 13 to 109 rows), which is not covered by its estimate (the companions keep "
+            f"the rows); the centre-line depths converge{rounded}"]
 
 
 def _yield_note(filled: Case, summary: dict, counter: "_Counter") -> None:

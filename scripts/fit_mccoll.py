@@ -43,11 +43,12 @@ def main() -> None:
         row = {"case": name, "k_m_mccoll": case.moving.wear_coefficient, "k_m_fitted": res.values[0],
                "k_s_mccoll": case.stationary.wear_coefficient, "k_s_fitted": res.values[1],
                "depth_residual": res.residuals[0], "width_residual": res.residuals[1], "runs": res.runs,
-               "seconds": seconds, "note": res.message}
+               "seconds": seconds, "note": "; ".join([res.message, *res.warnings])}
         rows.append(row)
         print(f"{name:17s} {row['k_m_mccoll']:11.3g} {row['k_m_fitted']:11.3g} {row['k_s_mccoll']:11.3g} "
               f"{row['k_s_fitted']:11.3g} {row['depth_residual']:+10.2%} {row['width_residual']:+10.2%} "
-              f"{res.runs:5d} {seconds:5.1f}" + ("" if res.converged else "  (k_m at the search's edge: no fit)"),
+              f"{res.runs:5d} {seconds:5.1f}" + ("  (k_m at the search's edge: no fit)" if not res.converged else
+                                                  "  (k_m not determined: no fit)" if not res.determined else ""),
               flush=True)
     write_csv(rows, ROOT / "scripts" / "results" / "fit_mccoll.csv")
 

@@ -158,6 +158,8 @@ def test_a_fit_to_one_measured_depth_holds_the_contact(tmp_path, truth):
            f"materials.stationary.wear_coefficient={K_STATIONARY / 3} 1/MPa"]
     res = fit(CASE.read_text(), str(CASE), read_measured(path), overrides=low)
     assert res.dof == -1 and abs(res.residuals[0]) < 1e-3
+    # a combination of the two is fitted, neither alone: not determined (the CLI exits 3 and writes no case)
+    assert res.undetermined == res.keys and not res.determined
 
 
 def test_a_wall_loss_column_on_a_cylinder_is_refused_by_name(tmp_path):
@@ -353,3 +355,19 @@ def test_a_fit_with_no_degrees_of_freedom_that_leaves_residuals_says_the_model_c
     path.write_text(f"cycle [cycles],max_wear_depth_stationary [um]\n{n1},{d1}\n{n2},{float(d2) * 1.5}\n")
     r = CliRunner().invoke(main, ["fit", str(CASE), "--measured", str(path), "--set", TWO_D])
     assert "no degrees of freedom" in r.output and "model cannot reproduce these data" in r.output, r.output
+
+
+def test_the_search_stays_within_a_values_own_range():
+    """A friction coefficient searched to 1000× its start ran 6 minutes and stopped at μ = 18.3, out of the key's
+    range [0, 10] (a review): the bounds are the key's range where it is narrower."""
+    import math
+
+    import numpy as np
+
+    from fretsim.fit import RANGE, _bounds, _spec
+    spec = _spec("loading.friction_coefficient")
+    lo, hi = _bounds(np.log([0.9]), [spec])
+    assert hi[0] <= math.log(spec.hi) + 1e-12 and lo[0] == pytest.approx(math.log(0.9 / RANGE))
+    k = _spec("materials.moving.wear_coefficient")
+    lo, hi = _bounds(np.log([2e-8]), [k])
+    assert hi[0] <= math.log(2e-8 * RANGE) + 1e-12 and lo[0] >= math.log(2e-8 / RANGE) - 1e-12

@@ -318,6 +318,9 @@ def test_a_square_ended_line_contacts_end_row_depth_grows_with_the_rows_and_the_
     said = [n for n in base.notes if "end row of the line contact" in n]
     assert len(said) == 1 and "the moving body" in said[0] and "the flat" in said[0], base.notes
     assert "not covered by its estimate" in said[0]
+    # a grid wider than the line (a review): its end rows are the last worn ones, not the grid's
+    wide = run(load_case(CASES / "mccoll_185N.yaml", [*sets, "grid.domain=[0.8 mm, 12 mm]", "grid.elements=[161, 33]"]))
+    assert any("end row of the line contact" in n for n in wide.notes), wide.notes
     flat = run(load_case(CASES / "mccoll_185N.yaml", ["model.dimension=2d", "loading.cycles=2000"]))
     rounded = run(load_case(CASES / "roller_edge_rounded.yaml", sets))
     for out in (flat, rounded):

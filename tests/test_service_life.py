@@ -321,6 +321,19 @@ def test_the_percentiles_of_a_few_latin_hypercube_samples_err_outwards_not_towar
     assert p10 > 1.05 and p90 < 0.95, (p10, p90)
 
 
+def test_the_depth_band_reads_its_samples_as_the_percentiles_file_does():
+    """The figure's band took numpy's default percentiles while percentiles.csv took each sample at its stratum's
+    middle (a review): both read through measures.quantiles now, a stopped sample (NaN) left out of its column."""
+    from fretsim.measures import column_quantiles, quantiles
+    rng = np.random.default_rng(1)
+    values = rng.lognormal(size=(10, 6))
+    values[3:5, 4:] = np.nan
+    p10, p50, p90 = column_quantiles(values)
+    for j in range(values.shape[1]):
+        column = values[:, j][~np.isnan(values[:, j])]
+        assert [p10[j], p50[j], p90[j]] == pytest.approx(list(quantiles(column)), rel=1e-15)
+
+
 def test_a_sampled_sweeps_plot_draws_the_band_and_the_histogram_of_the_time_to_the_limit(tmp_path):
     """Data, not pixels: the band's P10 ≤ P50 ≤ P90 everywhere, a sample at its limit held there (the band's P90
     reaches the limit), and the histogram's counts are every sample that reached it."""
