@@ -658,7 +658,9 @@ def _end_notes(setup: Setup, filled: Case, last: Step) -> list[str]:
     for body, h in (("the moving body", last.wear_moving), ("the flat", last.wear_stationary)):
         rows = h.max(axis=1)
         worn = np.flatnonzero(rows > 0)  # (a grid wider than the line: its end rows are the last worn ones)
-        if worn.size >= 3 and int(np.argmax(rows)) in (worn[0], worn[-1]):
+        # (deeper than the centre line beyond round-off: rows alike along y pick the first as argmax)
+        if (worn.size >= 3 and int(np.argmax(rows)) in (worn[0], worn[-1])
+                and rows.max() > rows[rows.size // 2] * (1 + 1e-9)):
             found.append(f"{body} ({rows.max() * 1e3:.4g} µm, {rows.max() / rows[rows.size // 2] - 1:.1%} over its "
                          f"centre line)")
     if not found:
