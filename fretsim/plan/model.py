@@ -39,8 +39,8 @@ PILOT_MARGIN = 1.3  # the grid of a run with wear limits holds the wear of this 
 # the pilot's stepping tolerance: it needs the stop to well within PILOT_MARGIN, and its steps' error estimates
 # over-state the depths' error 20-100x.  Measured on 15 cases with limits (2D and 3D, histories, Coulomb, resolved,
 # the stroke-averaged gap; scripts/results/pilot_tolerance.txt): the stops at 0.3 within 0.3 % of those at 0.03
-# (a review's ten more within 1 %, scar-width limits the furthest),
-# the pilots 1.1-2.9x fewer solves (the tube in service's 158 -> 104)
+# (a review's ten more within 1 %, scar-width limits the furthest), the pilots 1.1-2.9x fewer solves (the tube in
+# service's 158 -> 104)
 PILOT_TOLERANCE = 0.3
 FACES_NOTE = ("the free faces of {what} (paper §2.1; solved as a finite block, not the paper's overlapping "
               "half-spaces)")
@@ -363,8 +363,7 @@ def pilot_cycles(case: Case, runs: SideRuns, plan_case: PlanCase) -> Optional[fl
     pilot = case.with_choices(dimension="2d" if case.geometry.has_2d else "3d", corrections="none",
                               grid_rule="accuracy", accuracy=accuracy, grid_error="none",
                               step_tolerance=max(case.step_tolerance, PILOT_TOLERANCE), pressure_accuracy=None,
-                              snapshots=(0,),
-                              scheme="bdf2")
+                              snapshots=(0,), scheme="bdf2")
 
     def compute() -> Optional[float]:
         try:
