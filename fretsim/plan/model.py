@@ -39,7 +39,7 @@ PILOT_MARGIN = 1.3  # the grid of a run with wear limits holds the wear of this 
 # the pilot's stepping tolerance: it needs the stop to well within PILOT_MARGIN, and its steps' error estimates
 # over-state the depths' error 20-100x.  Measured on 15 cases with limits (2D and 3D, histories, Coulomb, resolved,
 # the stroke-averaged gap; scripts/results/pilot_tolerance.txt): the stops at 0.3 within 0.3 % of those at 0.03
-# (a review's ten more within 1 %, scar-width limits the furthest), the pilots 1.1-2.9x fewer solves (the tube in
+# (a review's ten more within 1 %, scar-width limits the furthest), the pilots 1.0-2.9x fewer solves (the tube in
 # service's 158 -> 104)
 PILOT_TOLERANCE = 0.3
 FACES_NOTE = ("the free faces of {what} (paper §2.1; solved as a finite block, not the paper's overlapping "
